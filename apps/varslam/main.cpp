@@ -1,0 +1,31 @@
+// varslam: RGB-D visual SLAM for dynamic scenes. One CLI, one subcommand per job.
+#include <spdlog/spdlog.h>
+
+#include <exception>
+
+#include "commands.hpp"
+#include "core/error.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"varslam: RGB-D visual SLAM that stays accurate where things move"};
+  app.require_subcommand(1);
+  bool verbose = false;
+  app.add_flag("-v,--verbose", verbose, "Debug logging");
+  app.parse_complete_callback([&] { spdlog::set_level(verbose ? spdlog::level::debug : spdlog::level::info); });
+  varslam::cli::add_demo_command(app);
+  varslam::cli::add_run_command(app);
+  varslam::cli::add_eval_command(app);
+  varslam::cli::add_synth_command(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const varslam::InputError& e) {
+    spdlog::error("{}", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    spdlog::error("internal error: {}", e.what());
+    return 3;
+  }
+  return 0;
+}

@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# Installs the Debian packages varslam builds and tests with. Idempotent: skips apt when all are present.
+set -euo pipefail
+PKGS=(build-essential cmake pkg-config ccache libopencv-dev libeigen3-dev libceres-dev libyaml-cpp-dev
+      libcli11-dev libfmt-dev libspdlog-dev nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev
+      opencv-doc)
+missing=()
+for p in "${PKGS[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  echo "[setup] installing: ${missing[*]}"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
