@@ -1,10 +1,48 @@
+// `varslam run`: SLAM over a dataset folder (TUM RGB-D / Bonn / OpenLORIS layouts, or a synthetic sequence).
+#include <spdlog/spdlog.h>
+
+#include "cli_common.hpp"
 #include "commands.hpp"
+#include "io/dataset.hpp"
 
 namespace varslam::cli {
 
 void add_run_command(CLI::App& app) {
-  auto* cmd = app.add_subcommand("run", "(not yet implemented)");
-  cmd->callback([] {});
+  struct Opts {
+    std::string dataset, settings, out = "out/run", groundtruth;
+    bool realtime = false, pace = false, quiet = false;
+    std::size_t first = 0, max_frames = SIZE_MAX;
+    std::vector<std::string> overrides;
+  };
+  auto o = std::make_shared<Opts>();
+  auto* cmd = app.add_subcommand("run", "Run SLAM on a dataset folder and write trajectory, map and metrics");
+  cmd->add_option("--dataset,-d", o->dataset, "Dataset folder (TUM/Bonn/OpenLORIS layout)")->required();
+  cmd->add_option("--settings,-s", o->settings, "Settings YAML (default: <dataset>/settings.yaml)");
+  cmd->add_option("--out,-o", o->out, "Output folder")->capture_default_str();
+  cmd->add_option("--groundtruth", o->groundtruth, "Ground truth TUM file (default: <dataset>/groundtruth.txt)");
+  cmd->add_flag("--realtime", o->realtime, "Real-time mode: local mapping on its own thread");
+  cmd->add_flag("--pace", o->pace, "With --realtime: feed frames at the dataset's frame rate");
+  cmd->add_option("--first", o->first, "First frame index");
+  cmd->add_option("--max-frames,-n", o->max_frames, "Process at most this many frames");
+  cmd->add_option("--set", o->overrides, "Override a setting: section.key=value (repeatable)");
+  cmd->add_flag("--quiet,-q", o->quiet, "No progress line");
+  cmd->callback([o] {
+    std::optional<std::filesystem::path> sfile;
+    if (!o->settings.empty()) sfile = o->settings;
+    Settings settings = settings_for_dataset(o->dataset, sfile);
+    apply_overrides(settings, o->overrides);
+    const slam::SlamConfig cfg = slam::slam_config_from(settings);
+    auto dataset = open_dataset(o->dataset, settings);
+    slam::RunOptions ro;
+    ro.mode = o->realtime ? slam::RunMode::RealTime : slam::RunMode::Deterministic;
+    ro.pace = o->pace;
+    ro.first = o->first;
+    ro.max_frames = o->max_frames;
+    ro.progress = !o->quiet;
+    if (!o->groundtruth.empty()) ro.groundtruth = o->groundtruth;
+    const slam::RunSummary s = slam::run_slam(*dataset, settings, cfg, ro, o->out);
+    print_run_summary(s);
+  });
 }
 
 }  // namespace varslam::cli

@@ -16,6 +16,8 @@ int main(int argc, char** argv) {
   varslam::cli::add_run_command(app);
   varslam::cli::add_eval_command(app);
   varslam::cli::add_synth_command(app);
+  varslam::cli::add_bench_command(app);
+  varslam::cli::add_report_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,46 @@
+#include "cli_common.hpp"
+
+#include <fmt/format.h>
+
+#include "core/error.hpp"
+
+namespace varslam::cli {
+
+void apply_overrides(Settings& settings, const std::vector<std::string>& overrides) {
+  for (const std::string& o : overrides) {
+    const auto eq = o.find('=');
+    const auto dot = o.find('.');
+    if (eq == std::string::npos || dot == std::string::npos || dot > eq || dot == 0 || eq == dot + 1)
+      throw ConfigError(fmt::format("--set '{}': expected section.key=value (e.g. mapping.kernel=barron-adaptive)", o));
+    const std::string section = o.substr(0, dot), key = o.substr(dot + 1, eq - dot - 1), value = o.substr(eq + 1);
+    if (!settings.root || !settings.root.IsMap()) settings.root = YAML::Node(YAML::NodeType::Map);
+    YAML::Node sec = settings.root[section];
+    if (sec && !sec.IsMap())
+      throw ConfigError(fmt::format("--set '{}': settings key '{}' is not a section", o, section));
+    settings.root[section][key] = YAML::Load(value);
+  }
+}
+
+void print_run_summary(const slam::RunSummary& s) {
+  fmt::print("frames           {}\n", s.frames);
+  fmt::print("tracked          {} ({:.1f}%), lost {}, map segments {}\n", s.tracked,
+             s.frames ? 100.0 * s.tracked / s.frames : 0.0, s.lost, s.segments);
+  fmt::print("map              {} keyframes, {} points\n", s.keyframes, s.map_points);
+  fmt::print("speed            {:.1f} frames/s over {:.1f} s\n", s.fps, s.wall_seconds);
+  if (s.metrics.contains("timings")) {
+    const auto& t = s.metrics["timings"];
+    fmt::print("tracking median  {:.2f} ms (extract {:.2f}, match {:.2f}, pose {:.2f}); local BA median {:.1f} ms\n",
+               t["tracking"]["median_ms"].get<double>(), t["extract"]["median_ms"].get<double>(),
+               t["match"]["median_ms"].get<double>(), t["pose_optimization"]["median_ms"].get<double>(),
+               t["local_ba"]["median_ms"].get<double>());
+  }
+  if (s.ate_rmse)
+    fmt::print("ATE              rmse {:.2f} cm, max {:.2f} cm\n", *s.ate_rmse * 100.0, *s.ate_max * 100.0);
+  else
+    fmt::print("ATE              (no ground truth)\n");
+  fmt::print("trajectory       {}\n", (s.out_dir / "CameraTrajectory.txt").string());
+  fmt::print("metrics          {}\n", (s.out_dir / "metrics.json").string());
+  fmt::print("map              {}\n", (s.out_dir / "map.ply").string());
+}
+
+}  // namespace varslam::cli

@@ -1,0 +1,18 @@
+#pragma once
+// Helpers shared by the subcommands: settings overrides from the command line, summary printing.
+#include <string>
+#include <vector>
+
+#include "io/settings.hpp"
+#include "slam/runner.hpp"
+
+namespace varslam::cli {
+
+/// Applies "section.key=value" overrides to the free-form stage sections of the settings (tracking, mapping,
+/// semantic, features, ...). Throws ConfigError on a malformed override.
+void apply_overrides(Settings& settings, const std::vector<std::string>& overrides);
+
+/// One human-readable block: frames, tracking share, keyframes, speed, ATE, and where the files went.
+void print_run_summary(const slam::RunSummary& s);
+
+}  // namespace varslam::cli

@@ -1,0 +1,18 @@
+#pragma once
+// Trajectories as TUM text files: "timestamp tx ty tz qx qy qz qw" per line (camera-to-world), '#' comments.
+#include <filesystem>
+
+#include "core/trajectory.hpp"
+
+namespace varslam {
+
+/// Reads a TUM trajectory. Throws InputError naming file:line on a malformed line, a non-finite value, a zero
+/// quaternion or a timestamp before the previous one. A repeated timestamp keeps the later pose (as the TUM
+/// tools do; real TUM ground truth has a few). Quaternions are re-normalised.
+Trajectory read_tum_trajectory(const std::filesystem::path& file);
+
+/// Writes a TUM trajectory (time with 6 decimals, values with 9 significant digits). Throws InputError if the
+/// file cannot be written.
+void write_tum_trajectory(const Trajectory& trajectory, const std::filesystem::path& file);
+
+}  // namespace varslam

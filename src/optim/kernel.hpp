@@ -1,0 +1,74 @@
+#pragma once
+// Robust kernels shared by every optimiser in this module (Ceres losses and the dedicated IRLS solver
+// evaluate the very same function), plus ORB-SLAM's chi-square outlier gates and the adaptive-alpha fit.
+#include <span>
+#include <vector>
+
+#include <ceres/loss_function.h>
+
+#include "robust/barron.hpp"
+
+namespace varslam::optim {
+
+enum class KernelType { None, Huber, BarronFixed, BarronAdaptive };
+
+struct KernelConfig {
+  KernelType type = KernelType::Huber;
+  double barron_alpha = 1.0;  // BarronFixed (also the starting alpha of BarronAdaptive before any fit)
+  double barron_c = 1.0;      // scale on whitened residuals
+  double tau = 10.0;          // truncation for the log-partition table (BarronAdaptive)
+  robust::AlphaFit fit = robust::AlphaFit::ResidualNorm;  // the paper's choice by default
+  bool chi2_gates = true;     // ORB-SLAM's outlier gates 5.991 (2 dof) / 7.815 (3 dof) on top of the kernel
+};
+
+/// 95% chi-square quantiles ORB-SLAM uses as outlier gates (and, squared-rooted, as Huber deltas).
+inline constexpr double kChi2Mono = 5.991;    // 2 dof
+inline constexpr double kChi2Stereo = 7.815;  // 3 dof
+inline double chi2_threshold(int dof) { return dof == 3 ? kChi2Stereo : kChi2Mono; }
+
+/// Kernel on a squared whitened error s, in Ceres' convention: out = {rho(s), rho'(s), rho''(s)}.
+/// `dof` (2 or 3) picks the Huber delta; `alpha` is used by both Barron types (fixed or current estimate).
+void evaluate_kernel(const KernelConfig& cfg, double alpha, int dof, double s, double out[3]);
+
+/// ceres::LossFunction calling evaluate_kernel. The alpha can change between solves (adaptive alternation);
+/// it must not change while a solve is running.
+class KernelLoss final : public ceres::LossFunction {
+ public:
+  KernelLoss(const KernelConfig& cfg, int dof, double alpha) : cfg_(cfg), dof_(dof), alpha_(alpha) {}
+  void Evaluate(double s, double out[3]) const override { evaluate_kernel(cfg_, alpha_, dof_, s, out); }
+  void set_alpha(double alpha) { alpha_ = alpha; }
+  double alpha() const { return alpha_; }
+
+ private:
+  KernelConfig cfg_;
+  int dof_;
+  double alpha_;
+};
+
+/// Loss for the configured kernel, or nullptr for KernelType::None (plain least squares). Caller owns it.
+KernelLoss* make_loss(const KernelConfig& cfg, int dof, double alpha);
+
+/// Alpha to use before any estimate: barron_alpha for the Barron kernels, 2 (L2) otherwise.
+inline double initial_alpha(const KernelConfig& cfg) {
+  return cfg.type == KernelType::BarronFixed || cfg.type == KernelType::BarronAdaptive ? cfg.barron_alpha : 2.0;
+}
+
+/// Collects the samples the alpha fit sees: one whitened residual norm per observation (ResidualNorm) or
+/// every whitened component (PerComponent).
+class AlphaSamples {
+ public:
+  explicit AlphaSamples(robust::AlphaFit fit) : fit_(fit) {}
+  void clear() { samples_.clear(); }
+  void add(std::span<const double> whitened_residual);
+  std::span<const double> samples() const { return samples_; }
+
+ private:
+  robust::AlphaFit fit_;
+  std::vector<double> samples_;
+};
+
+/// Grid-search alpha on the samples with the (cached, per tau) log-partition table. Returns the current
+/// alpha unchanged when there are no samples.
+double fit_alpha(const KernelConfig& cfg, std::span<const double> samples, double current_alpha);
+
+}  // namespace varslam::optim

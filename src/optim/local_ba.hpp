@@ -1,0 +1,60 @@
+#pragma once
+// Local Bundle Adjustment for local mapping on plain data: keyframe poses T_cw, world points, observations.
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "core/camera.hpp"
+#include "optim/kernel.hpp"
+#include "optim/reprojection.hpp"
+
+namespace varslam::optim {
+
+struct BaKeyframe {
+  Eigen::Isometry3d T_cw = Eigen::Isometry3d::Identity();
+  bool fixed = false;  // observes the local points but is not optimised (anchors the gauge)
+};
+
+struct BaObservation {
+  int keyframe = 0;  // index into BaProblem::keyframes
+  int point = 0;     // index into BaProblem::points
+  Observation obs;
+};
+
+struct BaProblem {
+  std::vector<BaKeyframe> keyframes;
+  std::vector<Eigen::Vector3d> points;
+  std::vector<BaObservation> observations;
+};
+
+struct BaConfig {
+  KernelConfig kernel;
+  int outer_iterations = 3;    // first phase: outer_iterations x iterations solver iterations
+  int iterations = 5;
+  int refine_iterations = 10;  // second phase, after the outlier gate
+  bool remove_outliers = true;
+  int max_threads = 1;
+};
+
+struct BaResult {
+  std::vector<bool> outlier_observation;  // at the final state: behind the camera, or failing the chi2 gate
+  std::vector<double> alpha_per_iteration;  // BarronAdaptive: the alpha fitted before each solve
+  double final_alpha = 2;                   // alpha of the last solve (barron_alpha for BarronFixed, 2 otherwise)
+  double seconds = 0;
+  // 0.5 * sum of squared whitened residuals over the observations that are inliers at the end, at the initial
+  // and at the final state (plain least squares, so comparable whatever kernel and alpha were used).
+  double initial_cost = 0, final_cost = 0;
+  int solver_iterations = 0;  // total over all Ceres solves
+};
+
+/// Local BA: optimise non-fixed keyframes and all points in place. ORB-SLAM-style schedule: solve, then mark
+/// observations failing the chi2 test (or with non-positive depth) as outliers, solve again without them.
+/// Fixed kernels solve the first phase in one go; BarronAdaptive alternates: each outer iteration estimates
+/// alpha on the current active whitened residuals (fixed state), then runs `iterations` solver iterations with
+/// that alpha; the refine phase fits alpha once more on the surviving observations.
+/// With kernel.chi2_gates = false only observations behind the camera are gated. Ceres SPARSE_SCHUR with
+/// points eliminated first, PoseManifold on the poses, deterministic with max_threads = 1.
+/// Throws std::invalid_argument on an observation indexing a missing keyframe or point.
+BaResult solve_local_ba(const PinholeCamera& cam, BaProblem& problem, const BaConfig& cfg);
+
+}  // namespace varslam::optim

@@ -1,0 +1,178 @@
+#include "report/bench_results.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "report/html.hpp"
+#include "report/run_report.hpp"
+
+namespace varslam::report {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// A cell value; a trailing '*' flags a mean over fewer runs than the cell has (some failed or had no ATE).
+std::string cell(double v, double scale, int decimals, std::size_t n, std::size_t total) {
+  if (n == 0) return total == 0 ? "" : "fail";
+  std::string s = format_number(v * scale, decimals);
+  if (n < total) s += "*";
+  return s;
+}
+
+struct Group {
+  std::string scenario, path;  // path empty = whole scenario
+  std::map<std::string, std::vector<const RunRecord*>> by_config;
+};
+
+std::string render_table(const std::vector<Group>& groups, const TableOptions& o, bool with_path) {
+  std::ostringstream t;
+  t << "| scenario |" << (with_path ? " path |" : "");
+  for (const auto& c : o.configs)
+    t << ' ' << c << " RMSE | " << c << " max | " << c << " CR % | " << c << " fps | " << c << " trk ms |";
+  if (o.peer) t << ' ' << o.peer_name << " RMSE | " << o.peer_name << " max | " << o.peer_name << " s |";
+  t << "\n|---|" << (with_path ? "---|" : "");
+  for (std::size_t i = 0; i < o.configs.size(); ++i) t << "--:|--:|--:|--:|--:|";
+  if (o.peer) t << "--:|--:|--:|";
+  t << '\n';
+  for (const auto& g : groups) {
+    t << "| " << g.scenario << " |" << (with_path ? " " + g.path + " |" : "");
+    for (const auto& c : o.configs) {
+      const auto it = g.by_config.find(c);
+      const CellMean m = it == g.by_config.end() ? CellMean{} : mean_of(it->second);
+      t << ' ' << cell(m.ate_rmse_m, 100, 2, m.n_ate, m.n_runs) << " | " << cell(m.ate_max_m, 100, 2, m.n_ate, m.n_runs)
+        << " | " << cell(m.correct_rate, 100, 1, m.n_ate, m.n_runs) << " | " << cell(m.fps, 1, 1, m.n_speed, m.n_runs)
+        << " | " << cell(m.tracking_median_ms, 1, 1, m.n_speed, m.n_runs) << " |";
+    }
+    if (o.peer) {
+      const auto it = g.by_config.find("peer");
+      const CellMean m = it == g.by_config.end() ? CellMean{} : mean_of(it->second);
+      t << ' ' << cell(m.ate_rmse_m, 100, 2, m.n_ate, m.n_runs) << " | " << cell(m.ate_max_m, 100, 2, m.n_ate, m.n_runs)
+        << " | " << cell(m.wall_seconds, 1, 1, m.n_wall, m.n_runs) << " |";
+    }
+    t << '\n';
+  }
+  return t.str();
+}
+
+}  // namespace
+
+RunFigures figures_from_metrics(const nlohmann::json& m) {
+  RunFigures f{kNaN, kNaN, kNaN, kNaN, kNaN, kNaN};
+  if (!m.is_object()) return f;
+  f.ate_rmse_m = json_number(m, {"ate", "rmse"});
+  f.ate_max_m = json_number(m, {"ate", "max"});
+  f.correct_rate = json_number(m, {"ate", "correct_rate"});
+  f.fps = json_number(m, {"fps"});
+  f.tracking_median_ms = json_number(m, {"timings", "tracking", "median_ms"});
+  f.wall_seconds = json_number(m, {"wall_seconds"});
+  return f;
+}
+
+CellMean mean_of(const std::vector<const RunRecord*>& records) {
+  CellMean m;
+  m.n_runs = records.size();
+  for (const RunRecord* r : records) {
+    if (!r->ok) continue;
+    ++m.n_ok;
+    const RunFigures& f = r->figures;
+    if (std::isfinite(f.ate_rmse_m) && std::isfinite(f.ate_max_m)) {
+      ++m.n_ate;
+      m.ate_rmse_m += f.ate_rmse_m;
+      m.ate_max_m += f.ate_max_m;
+      m.correct_rate += std::isfinite(f.correct_rate) ? f.correct_rate : 0.0;
+    }
+    if (std::isfinite(f.fps) && std::isfinite(f.tracking_median_ms)) {
+      ++m.n_speed;
+      m.fps += f.fps;
+      m.tracking_median_ms += f.tracking_median_ms;
+    }
+    if (std::isfinite(f.wall_seconds)) {
+      ++m.n_wall;
+      m.wall_seconds += f.wall_seconds;
+    }
+  }
+  const auto div = [](double& v, std::size_t n) { v = n ? v / static_cast<double>(n) : kNaN; };
+  div(m.ate_rmse_m, m.n_ate);
+  div(m.ate_max_m, m.n_ate);
+  div(m.correct_rate, m.n_ate);
+  div(m.fps, m.n_speed);
+  div(m.tracking_median_ms, m.n_speed);
+  div(m.wall_seconds, m.n_wall);
+  return m;
+}
+
+std::string render_markdown_tables(const std::vector<RunRecord>& records, const TableOptions& o) {
+  std::vector<Group> per_scenario, per_path;
+  auto find_or_add = [](std::vector<Group>& groups, const std::string& scenario, const std::string& path) -> Group& {
+    for (auto& g : groups)
+      if (g.scenario == scenario && g.path == path) return g;
+    groups.push_back({scenario, path, {}});
+    return groups.back();
+  };
+  for (const auto& r : records) {
+    // Real folders are each their own row in both tables: averaging different recordings means nothing.
+    const std::string scenario = r.scenario == "real" ? "real: " + r.path_name : r.scenario;
+    find_or_add(per_scenario, scenario, "").by_config[r.config].push_back(&r);
+    find_or_add(per_path, scenario, r.scenario == "real" ? std::string("-") : r.path_name).by_config[r.config].push_back(&r);
+  }
+  std::ostringstream md;
+  md << "Per scenario (mean over camera paths and seeds). RMSE / max: ATE in cm; CR: correct rate (share of "
+        "frames with an associated pose); fps: frames per second of the whole run; trk ms: median tracking time "
+        "per frame. `*`: mean over fewer runs than planned (some failed or had no ATE); `fail`: no run gave a "
+        "figure.\n\n";
+  md << render_table(per_scenario, o, false);
+  md << "\nPer scenario and camera path (mean over seeds):\n\n";
+  md << render_table(per_path, o, true);
+  return md.str();
+}
+
+std::string replace_between_markers(const std::string& document, const std::string& generated,
+                                    const std::string& document_name) {
+  const auto begin = document.find(kTableBeginMarker);
+  const auto end = document.find(kTableEndMarker);
+  if (begin == std::string::npos || end == std::string::npos || end < begin)
+    throw InputError(fmt::format("{}: needs the marker lines {} and {} (in that order) around the generated table",
+                                 document_name, kTableBeginMarker, kTableEndMarker));
+  const auto after_begin = begin + std::string(kTableBeginMarker).size();
+  std::string body = generated;
+  if (body.empty() || body.back() != '\n') body += '\n';
+  return document.substr(0, after_begin) + "\n" + body + document.substr(end);
+}
+
+void update_benchmarks_md(const std::filesystem::path& file, const std::string& generated) {
+  std::ifstream in(file);
+  if (!in) throw InputError(file.string() + ": cannot read (create it with the two marker lines first)");
+  std::stringstream buf;
+  buf << in.rdbuf();
+  const std::string updated = replace_between_markers(buf.str(), generated, file.string());
+  std::ofstream out(file);
+  out << updated;
+  if (!out) throw InputError(file.string() + ": cannot write");
+}
+
+nlohmann::json to_json(const RunRecord& r) {
+  auto num = [](double v) -> nlohmann::json { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  return {{"sequence", r.sequence_id},
+          {"scenario", r.scenario},
+          {"path", r.path_name},
+          {"seed", r.seed},
+          {"config", r.config},
+          {"ok", r.ok},
+          {"error", r.error},
+          {"ate_rmse_m", num(r.figures.ate_rmse_m)},
+          {"ate_max_m", num(r.figures.ate_max_m)},
+          {"correct_rate", num(r.figures.correct_rate)},
+          {"fps", num(r.figures.fps)},
+          {"tracking_median_ms", num(r.figures.tracking_median_ms)},
+          {"wall_seconds", num(r.figures.wall_seconds)},
+          {"run_dir", r.run_dir.string()},
+          {"report", r.report_html.string()}};
+}
+
+}  // namespace varslam::report

@@ -1,0 +1,36 @@
+#pragma once
+// The `semantic:` section of a settings file -> detector and filter configuration.
+//
+//   semantic:
+//     detector: yolo            # yolo | boxes | hog | none
+//     model: yolo-fastest-1.1-xl  # preset, or model_cfg/model_weights (Darknet) / model_weights: x.onnx
+//     model_dir: ../models      # relative paths are relative to the settings file
+//     names_file: coco.names
+//     input_size: 320
+//     conf_threshold: 0.3
+//     nms_threshold: 0.45
+//     classes: [person]
+//     label_aliases: {body: person}
+//     num_threads: 0
+//     boxes_file: boxes.txt
+//     box_enlarge: 0.1
+//     depth_band_m: 0.5
+//     asynchronous: true        # false: wait for each frame's detections (deterministic)
+//     propagate_boxes: true     # shift stale boxes by optical flow
+#include "io/settings.hpp"
+#include "semantic/detector.hpp"
+#include "semantic/keypoint_filter.hpp"
+
+namespace varslam::semantic {
+
+struct SemanticSettings {
+  DetectorConfig detector;
+  FilterConfig filter;
+  bool asynchronous = true;
+  bool propagate_boxes = true;
+};
+
+/// Defaults for missing keys; a key with a wrong type or value is a ConfigError naming the settings file and key.
+SemanticSettings semantic_settings(const Settings& s);
+
+}  // namespace varslam::semantic

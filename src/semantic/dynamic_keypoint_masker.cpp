@@ -1,0 +1,60 @@
+#include "semantic/dynamic_keypoint_masker.hpp"
+
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+
+#include "semantic/box_propagation.hpp"
+
+namespace varslam::semantic {
+namespace {
+
+constexpr std::size_t kHistoryFrames = 10;  // boxes older than this many frames are used unpropagated
+
+cv::Mat gray_of(const RgbdFrame& f) {
+  if (!f.gray.empty()) return f.gray;
+  cv::Mat g;
+  if (f.bgr.channels() == 3) cv::cvtColor(f.bgr, g, cv::COLOR_BGR2GRAY);
+  else g = f.bgr;
+  return g;
+}
+
+}  // namespace
+
+DynamicKeypointMasker::DynamicKeypointMasker(const SemanticSettings& settings)
+    : DynamicKeypointMasker(make_detector(settings.detector), settings) {}
+
+DynamicKeypointMasker::DynamicKeypointMasker(std::unique_ptr<Detector> detector, const SemanticSettings& settings)
+    : settings_(settings), async_(std::move(detector)) {}
+
+MaskResult DynamicKeypointMasker::process(const RgbdFrame& frame, const std::vector<cv::KeyPoint>& kps) {
+  const cv::Mat& image = frame.bgr.empty() ? frame.gray : frame.bgr;
+  async_.submit(image, frame.timestamp);
+  if (!settings_.asynchronous) async_.wait_idle();
+
+  const cv::Mat gray = gray_of(frame);
+  if (settings_.propagate_boxes && !gray.empty()) {
+    history_.push_back({frame.timestamp, gray});
+    if (history_.size() > kHistoryFrames) history_.pop_front();
+  }
+
+  MaskResult out;
+  if (const auto latest = async_.latest()) {
+    out.have_detections = true;
+    out.boxes = latest->detections;
+    out.staleness_s = frame.timestamp - latest->timestamp;
+    out.detector_latency_s = latest->latency_s;
+    if (settings_.propagate_boxes && !out.boxes.empty() && out.staleness_s > 0.0) {
+      for (const auto& past : history_) {
+        if (std::abs(past.timestamp - latest->timestamp) < 1e-6) {
+          out.boxes = propagate_boxes(out.boxes, past.gray, gray);
+          out.propagated = true;
+          break;
+        }
+      }
+    }
+  }
+  out.keep = filter_keypoints(kps, frame.depth, out.boxes, settings_.filter, &out.stats);
+  return out;
+}
+
+}  // namespace varslam::semantic

@@ -1,0 +1,50 @@
+#pragma once
+// The whole semantic stage for the tracker, one call per frame: submit the frame to the (asynchronous) detector,
+// take the freshest boxes, move them onto this frame if they are older, and run the depth-aware filter.
+#include <deque>
+#include <memory>
+#include <optional>
+
+#include "core/rgbd_frame.hpp"
+#include "semantic/async_detector.hpp"
+#include "semantic/detector_settings.hpp"
+#include "semantic/keypoint_filter.hpp"
+
+namespace varslam::semantic {
+
+struct MaskResult {
+  std::vector<bool> keep;  // one per keypoint
+  FilterStats stats;
+  Detections boxes;            // as used on this frame (after propagation)
+  bool have_detections = false;  // false until the detector finished its first frame
+  double staleness_s = 0.0;    // frame time - time of the image the boxes were detected in
+  double detector_latency_s = 0.0;
+  bool propagated = false;
+};
+
+class DynamicKeypointMasker {
+ public:
+  /// Throws InputError from make_detector() (e.g. a missing model file).
+  explicit DynamicKeypointMasker(const SemanticSettings& settings);
+  /// Takes an already built detector (tests, custom detectors).
+  DynamicKeypointMasker(std::unique_ptr<Detector> detector, const SemanticSettings& settings);
+
+  /// frame.bgr (or gray) feeds the detector, frame.gray the box propagation, frame.depth the filter.
+  MaskResult process(const RgbdFrame& frame, const std::vector<cv::KeyPoint>& kps);
+
+  /// Blocks until the detector has finished every submitted frame.
+  void wait_for_detector() { async_.wait_idle(); }
+  std::string detector_name() const { return async_.name(); }
+  long detector_runs() const { return async_.processed(); }
+
+ private:
+  struct PastGray {
+    double timestamp;
+    cv::Mat gray;
+  };
+  SemanticSettings settings_;
+  AsyncDetector async_;
+  std::deque<PastGray> history_;  // recent gray images, to propagate boxes from the image they were found in
+};
+
+}  // namespace varslam::semantic

@@ -1,0 +1,80 @@
+#include "slam/config.hpp"
+
+#include <fmt/format.h>
+
+#include "core/error.hpp"
+
+namespace varslam::slam {
+
+optim::KernelType parse_kernel(const std::string& name, const std::string& where) {
+  if (name == "huber") return optim::KernelType::Huber;
+  if (name == "barron-fixed") return optim::KernelType::BarronFixed;
+  if (name == "barron-adaptive") return optim::KernelType::BarronAdaptive;
+  if (name == "none") return optim::KernelType::None;
+  throw ConfigError(fmt::format("{}: unknown kernel '{}' (use huber, barron-fixed, barron-adaptive or none)", where, name));
+}
+
+std::string kernel_name(optim::KernelType type) {
+  switch (type) {
+    case optim::KernelType::Huber: return "huber";
+    case optim::KernelType::BarronFixed: return "barron-fixed";
+    case optim::KernelType::BarronAdaptive: return "barron-adaptive";
+    case optim::KernelType::None: return "none";
+  }
+  return "?";
+}
+
+namespace {
+
+void read_kernel(const Settings& s, const std::string& section, optim::KernelConfig& k) {
+  const std::string where = fmt::format("{}: key {}.kernel", s.source.empty() ? "settings" : s.source.string(), section);
+  k.type = parse_kernel(setting_or<std::string>(s, section + ".kernel", kernel_name(k.type)), where);
+  k.barron_alpha = setting_or<double>(s, section + ".barron_alpha", k.barron_alpha);
+  k.barron_c = setting_or<double>(s, section + ".barron_c", k.barron_c);
+  k.tau = setting_or<double>(s, section + ".tau", k.tau);
+  k.chi2_gates = setting_or<bool>(s, section + ".chi2_gates", k.chi2_gates);
+  const std::string fit = setting_or<std::string>(s, section + ".alpha_fit",
+                                                  k.fit == robust::AlphaFit::ResidualNorm ? "norm" : "component");
+  if (fit == "norm") k.fit = robust::AlphaFit::ResidualNorm;
+  else if (fit == "component") k.fit = robust::AlphaFit::PerComponent;
+  else throw ConfigError(fmt::format("{}: key {}.alpha_fit must be 'norm' or 'component', got '{}'",
+                                     s.source.string(), section, fit));
+  if (k.barron_c <= 0 || k.tau <= 0)
+    throw ConfigError(fmt::format("{}: {}.barron_c and {}.tau must be positive", s.source.string(), section, section));
+}
+
+}  // namespace
+
+SlamConfig slam_config_from(const Settings& s) {
+  SlamConfig c;
+  c.fps = s.fps;
+  c.orb.n_features = s.orb.n_features;
+  c.orb.scale_factor = s.orb.scale_factor;
+  c.orb.n_levels = s.orb.n_levels;
+  c.orb.ini_th_fast = s.orb.ini_th_fast;
+  c.orb.min_th_fast = s.orb.min_th_fast;
+  const std::string ex = setting_or<std::string>(s, "features.extractor", "ours");
+  if (ex == "ours") c.extractor = ExtractorKind::Ours;
+  else if (ex == "opencv") c.extractor = ExtractorKind::OpenCV;
+  else throw ConfigError(fmt::format("{}: key features.extractor must be 'ours' or 'opencv', got '{}'", s.source.string(), ex));
+
+  c.tracking.kernel.type = optim::KernelType::Huber;
+  read_kernel(s, "tracking", c.tracking.kernel);
+  c.tracking.motion_radius = setting_or<double>(s, "tracking.motion_radius", c.tracking.motion_radius);
+  c.tracking.min_inliers_local_map = setting_or<int>(s, "tracking.min_inliers", c.tracking.min_inliers_local_map);
+  c.tracking.lost_frames_before_reinit =
+      setting_or<int>(s, "tracking.lost_frames_before_reinit", c.tracking.lost_frames_before_reinit);
+
+  c.mapping.kernel.type = optim::KernelType::Huber;
+  read_kernel(s, "mapping", c.mapping.kernel);
+  c.mapping.ba_outer_iterations = setting_or<int>(s, "mapping.ba_outer_iterations", c.mapping.ba_outer_iterations);
+  c.mapping.ba_iterations = setting_or<int>(s, "mapping.ba_iterations", c.mapping.ba_iterations);
+  c.mapping.ba_refine_iterations = setting_or<int>(s, "mapping.ba_refine_iterations", c.mapping.ba_refine_iterations);
+  c.mapping.cull_keyframes = setting_or<bool>(s, "mapping.cull_keyframes", c.mapping.cull_keyframes);
+  if (c.mapping.ba_outer_iterations < 1 || c.mapping.ba_iterations < 1)
+    throw ConfigError(fmt::format("{}: mapping.ba_outer_iterations and mapping.ba_iterations must be >= 1",
+                                  s.source.string()));
+  return c;
+}
+
+}  // namespace varslam::slam

@@ -1,0 +1,45 @@
+#pragma once
+// Everything the SLAM stages need to know, read once from the settings file.
+#include <string>
+
+#include "features/feature_extractor.hpp"
+#include "io/settings.hpp"
+#include "optim/kernel.hpp"
+
+namespace varslam::slam {
+
+struct TrackingConfig {
+  optim::KernelConfig kernel;      // pose-only optimisation (ORB-SLAM3: Huber)
+  double motion_radius = 15.0;     // search radius (pixels at level 0) when matching against the last frame
+  int min_matches = 20;            // motion-model matches needed before optimising
+  int min_inliers_local_map = 30;  // inliers after local-map tracking for the frame to count as tracked
+  int max_local_keyframes = 80;
+  int lost_frames_before_reinit = 3;  // failed recoveries before a new map segment starts
+  int vo_points = 100;             // temporary depth points in the last frame (RGB-D visual odometry)
+};
+
+struct MappingConfig {
+  optim::KernelConfig kernel;  // Local BA (paper: adaptive Barron; ORB-SLAM3: Huber)
+  int ba_outer_iterations = 3;
+  int ba_iterations = 5;
+  int ba_refine_iterations = 10;
+  int triangulation_neighbours = 10;
+  double keyframe_redundancy = 0.9;  // share of points seen by >= 3 other keyframes that makes a keyframe redundant
+  bool cull_keyframes = true;
+};
+
+struct SlamConfig {
+  OrbParams orb;
+  ExtractorKind extractor = ExtractorKind::Ours;
+  TrackingConfig tracking;
+  MappingConfig mapping;
+  double fps = 30.0;
+};
+
+/// Reads `tracking.*`, `mapping.*`, `features.*` (and the ORB parameters) from the settings; a bad value is a
+/// ConfigError naming the file and key. Kernel names: huber, barron-fixed, barron-adaptive, none.
+SlamConfig slam_config_from(const Settings& settings);
+optim::KernelType parse_kernel(const std::string& name, const std::string& where);
+std::string kernel_name(optim::KernelType type);
+
+}  // namespace varslam::slam

@@ -1,0 +1,106 @@
+#pragma once
+// A keyframe: a frame kept in the map. Owns its pose (guarded), its keypoint-to-map-point associations
+// (guarded), and its place in the covisibility graph and spanning tree (guarded).
+#include <Eigen/Geometry>
+#include <atomic>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <set>
+#include <vector>
+
+#include "slam/frame.hpp"
+#include "slam/id_order.hpp"
+#include "slam/map_point.hpp"
+
+namespace varslam::slam {
+
+class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
+ public:
+  KeyFrame(long id, const Frame& frame);
+
+  long id() const { return id_; }
+  long frame_id() const { return frame_id_; }
+  double timestamp() const { return timestamp_; }
+  const FrameFeatures& features() const { return *features_; }
+  const std::shared_ptr<const FrameFeatures>& features_ptr() const { return features_; }
+
+  Eigen::Isometry3d pose() const;  // T_cw
+  Eigen::Isometry3d pose_inverse() const;  // T_wc
+  Eigen::Vector3d camera_center() const;
+  void set_pose(const Eigen::Isometry3d& T_cw);
+  /// Pose for trajectory output: a culled keyframe follows its parent through the relative pose it had when
+  /// it was culled, so frames anchored to it still move with later corrections.
+  Eigen::Isometry3d resolved_pose() const;
+
+  // Map point associations (index = keypoint index).
+  std::vector<MapPointPtr> map_points() const;
+  MapPointPtr map_point(int idx) const;
+  void add_map_point(const MapPointPtr& mp, int idx);
+  void erase_map_point(int idx);
+  void erase_map_point(const MapPoint* mp);
+  void replace_map_point(int idx, const MapPointPtr& mp);
+  /// Map points (not bad) seen by at least min_obs keyframes.
+  int tracked_map_points(int min_obs) const;
+
+  // Covisibility graph.
+  void update_connections();
+  void add_connection(const std::shared_ptr<KeyFrame>& kf, int weight);
+  void erase_connection(const std::shared_ptr<KeyFrame>& kf);
+  std::vector<std::shared_ptr<KeyFrame>> covisibles() const;               // by weight, descending
+  std::vector<std::shared_ptr<KeyFrame>> best_covisibles(std::size_t n) const;
+  std::vector<std::shared_ptr<KeyFrame>> covisibles_with_weight(int min_weight) const;
+  int weight(const std::shared_ptr<KeyFrame>& kf) const;
+
+  // Spanning tree.
+  std::shared_ptr<KeyFrame> parent() const;
+  std::set<std::shared_ptr<KeyFrame>, IdLess> children() const;
+  void add_child(const std::shared_ptr<KeyFrame>& kf);
+  void erase_child(const std::shared_ptr<KeyFrame>& kf);
+  void change_parent(const std::shared_ptr<KeyFrame>& kf);
+
+  /// Detaches the keyframe from its points and the graph, reconnecting its children; never the first one.
+  void set_bad();
+  bool is_bad() const { return bad_.load(); }
+  /// Drops every graph reference (connections, parent, children): breaks shared_ptr cycles at shutdown.
+  void clear_graph();
+  void set_not_erase(bool v) { not_erase_ = v; }
+
+  /// Median depth of its map points in this camera (for triangulation baselines).
+  double median_depth() const;
+
+  // Local mapping / tracking scratch.
+  long local_for_frame = -1;
+  long ba_local_for_kf = -1;
+  long ba_fixed_for_kf = -1;
+
+ private:
+  const long id_;
+  const long frame_id_;
+  const double timestamp_;
+  std::shared_ptr<const FrameFeatures> features_;
+
+  mutable std::mutex pose_mutex_;
+  Eigen::Isometry3d T_cw_;
+  Eigen::Isometry3d T_c_parent_ = Eigen::Isometry3d::Identity();  // set when culled
+
+  mutable std::mutex features_mutex_;
+  std::vector<MapPointPtr> map_points_;
+
+  mutable std::mutex graph_mutex_;
+  std::map<std::shared_ptr<KeyFrame>, int, IdLess> connections_;
+  std::vector<std::shared_ptr<KeyFrame>> ordered_covisibles_;
+  std::vector<int> ordered_weights_;
+  std::shared_ptr<KeyFrame> parent_;
+  std::set<std::shared_ptr<KeyFrame>, IdLess> children_;
+  bool first_connection_ = true;
+
+  std::atomic<bool> bad_{false};
+  std::atomic<bool> not_erase_{false};
+
+  void sort_connections_locked();
+};
+
+using KeyFramePtr = std::shared_ptr<KeyFrame>;
+
+}  // namespace varslam::slam

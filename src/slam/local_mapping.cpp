@@ -1,0 +1,383 @@
+#include "slam/local_mapping.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <Eigen/SVD>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <set>
+
+#include "optim/local_ba.hpp"
+#include "slam/matcher.hpp"
+
+namespace varslam::slam {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+/// Linear (DLT) triangulation from two camera-from-world poses and normalised image coordinates.
+bool triangulate_dlt(const Eigen::Isometry3d& T1, const Eigen::Isometry3d& T2, const Eigen::Vector2d& x1,
+                     const Eigen::Vector2d& x2, Eigen::Vector3d& out) {
+  const Eigen::Matrix<double, 3, 4> P1 = T1.matrix().topRows<3>();
+  const Eigen::Matrix<double, 3, 4> P2 = T2.matrix().topRows<3>();
+  Eigen::Matrix4d A;
+  A.row(0) = x1.x() * P1.row(2) - P1.row(0);
+  A.row(1) = x1.y() * P1.row(2) - P1.row(1);
+  A.row(2) = x2.x() * P2.row(2) - P2.row(0);
+  A.row(3) = x2.y() * P2.row(2) - P2.row(1);
+  const Eigen::JacobiSVD<Eigen::Matrix4d> svd(A, Eigen::ComputeFullV);
+  const Eigen::Vector4d h = svd.matrixV().col(3);
+  if (std::abs(h(3)) < 1e-12) return false;
+  out = h.head<3>() / h(3);
+  return out.allFinite();
+}
+
+}  // namespace
+
+LocalMapper::LocalMapper(const MappingConfig& cfg, Map& map, std::shared_ptr<const ScaleInfo> scale, double close_depth)
+    : cfg_(cfg), map_(map), scale_(std::move(scale)), close_depth_(close_depth) {}
+
+LocalMapper::~LocalMapper() { stop(); }
+
+bool LocalMapper::accepts_keyframes() const { return !busy_.load() && queued() == 0; }
+
+std::size_t LocalMapper::queued() const {
+  std::lock_guard lock(queue_mutex_);
+  return queue_.size();
+}
+
+void LocalMapper::insert(const KeyFramePtr& kf) {
+  {
+    std::lock_guard lock(queue_mutex_);
+    queue_.push_back(kf);
+  }
+  abort_ba_ = true;
+  queue_cv_.notify_one();
+}
+
+void LocalMapper::process_all() {
+  for (;;) {
+    KeyFramePtr kf;
+    {
+      std::lock_guard lock(queue_mutex_);
+      if (queue_.empty()) return;
+      kf = queue_.front();
+      queue_.pop_front();
+    }
+    process(kf);
+  }
+}
+
+void LocalMapper::start() {
+  if (thread_.joinable()) return;
+  stop_requested_ = false;
+  thread_ = std::thread([this] { run(); });
+}
+
+void LocalMapper::stop() {
+  if (!thread_.joinable()) return;
+  stop_requested_ = true;
+  queue_cv_.notify_all();
+  thread_.join();
+}
+
+void LocalMapper::run() {
+  for (;;) {
+    KeyFramePtr kf;
+    {
+      std::unique_lock lock(queue_mutex_);
+      queue_cv_.wait(lock, [&] { return stop_requested_ || !queue_.empty(); });
+      if (queue_.empty()) return;  // stop requested and nothing left
+      kf = queue_.front();
+      queue_.pop_front();
+      busy_ = true;
+    }
+    process(kf);
+    busy_ = false;
+  }
+}
+
+MappingStats LocalMapper::stats() const {
+  std::lock_guard lock(stats_mutex_);
+  return stats_;
+}
+
+void LocalMapper::process(const KeyFramePtr& kf) {
+  const auto t0 = Clock::now();
+  abort_ba_ = false;
+  add_observations(kf);
+  cull_recent_points(kf);
+  triangulate(kf);
+  if (queued() == 0) fuse_neighbours(kf);
+  if (queued() == 0) {
+    local_ba(kf);
+    if (cfg_.cull_keyframes) cull_keyframes(kf);
+  }
+  remove_bad_from_map();
+  std::lock_guard lock(stats_mutex_);
+  stats_.keyframe_ms.push_back(ms_since(t0));
+}
+
+void LocalMapper::add_observations(const KeyFramePtr& kf) {
+  const auto points = kf->map_points();
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const MapPointPtr& mp = points[i];
+    if (!mp || mp->is_bad()) continue;
+    if (mp->index_in(kf.get()) < 0) {
+      mp->add_observation(kf, static_cast<int>(i), kf->features().has_depth(i));
+      mp->update_normal_and_depth(scale_->scale_factors);
+      mp->compute_descriptor();
+    } else {
+      recent_points_.push_back(mp);  // created by tracking for this keyframe
+    }
+  }
+  kf->update_connections();
+}
+
+void LocalMapper::cull_recent_points(const KeyFramePtr& kf) {
+  constexpr int kMinObservations = 3;  // RGB-D: a point needs support beyond its creating keyframe
+  int culled = 0;
+  for (auto it = recent_points_.begin(); it != recent_points_.end();) {
+    const MapPointPtr& mp = *it;
+    const long age = kf->id() - mp->first_keyframe_id();
+    if (mp->is_bad()) {
+      it = recent_points_.erase(it);
+    } else if (mp->found_ratio() < 0.25 || (age >= 2 && mp->num_observations() <= kMinObservations)) {
+      mp->set_bad();
+      ++culled;
+      it = recent_points_.erase(it);
+    } else if (age >= 3) {
+      it = recent_points_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  std::lock_guard lock(stats_mutex_);
+  stats_.culled_points += culled;
+}
+
+void LocalMapper::triangulate(const KeyFramePtr& kf) {
+  const FrameFeatures& A = kf->features();
+  const ScaleInfo& S = *scale_;
+  const Eigen::Isometry3d T1 = kf->pose();
+  const Eigen::Isometry3d T1_inv = T1.inverse();
+  const Eigen::Vector3d C1 = T1_inv.translation();
+  const double baseline = A.camera.bf / A.camera.fx;
+  const double ratio_factor = 1.5 * S.scale_factor;
+  const auto normalized = [&](const cv::KeyPoint& kp) {
+    return Eigen::Vector2d((kp.pt.x - A.camera.cx) / A.camera.fx, (kp.pt.y - A.camera.cy) / A.camera.fy);
+  };
+  int created = 0;
+  for (const auto& nb : kf->best_covisibles(static_cast<std::size_t>(cfg_.triangulation_neighbours))) {
+    if (queued() > 0 && created > 0) break;
+    const Eigen::Isometry3d T2 = nb->pose();
+    const Eigen::Isometry3d T2_inv = T2.inverse();
+    const Eigen::Vector3d C2 = T2_inv.translation();
+    if ((C2 - C1).norm() < baseline) continue;
+    const FrameFeatures& B = nb->features();
+    for (const auto& [i1, i2] : match_for_triangulation(*kf, *nb)) {
+      const cv::KeyPoint& k1 = A.keypoints[i1];
+      const cv::KeyPoint& k2 = B.keypoints[i2];
+      const Eigen::Vector2d x1 = normalized(k1), x2 = normalized(k2);
+      const Eigen::Vector3d r1 = T1_inv.rotation() * x1.homogeneous();
+      const Eigen::Vector3d r2 = T2_inv.rotation() * x2.homogeneous();
+      const double cos_parallax = r1.dot(r2) / (r1.norm() * r2.norm());
+      if (cos_parallax <= 0 || cos_parallax > 0.9998) continue;  // need about a degree of parallax
+      Eigen::Vector3d pw;
+      if (!triangulate_dlt(T1, T2, x1, x2, pw)) continue;
+      const Eigen::Vector3d p1 = T1 * pw, p2 = T2 * pw;
+      if (p1.z() <= 0 || p2.z() <= 0) continue;
+      const auto reproj_ok = [&](const Eigen::Vector3d& pc, const cv::KeyPoint& kp) {
+        const Eigen::Vector2d uv = A.camera.project(pc);
+        const double e2 = (uv - Eigen::Vector2d(kp.pt.x, kp.pt.y)).squaredNorm();
+        return e2 <= 5.991 * S.level_sigma2[kp.octave];
+      };
+      if (!reproj_ok(p1, k1) || !reproj_ok(p2, k2)) continue;
+      const double d1 = (pw - C1).norm(), d2 = (pw - C2).norm();
+      if (d1 == 0 || d2 == 0) continue;
+      const double ratio_dist = d2 / d1;
+      const double ratio_octave = S.scale_factors[k1.octave] / S.scale_factors[k2.octave];
+      if (ratio_dist * ratio_factor < ratio_octave || ratio_dist > ratio_octave * ratio_factor) continue;
+      if (kf->map_point(i1) || nb->map_point(i2)) continue;
+      auto mp = std::make_shared<MapPoint>(map_.next_map_point_id(), pw, kf);
+      mp->add_observation(kf, i1, A.has_depth(i1));
+      mp->add_observation(nb, i2, B.has_depth(i2));
+      kf->add_map_point(mp, i1);
+      nb->add_map_point(mp, i2);
+      mp->compute_descriptor();
+      mp->update_normal_and_depth(S.scale_factors);
+      map_.add_map_point(mp);
+      recent_points_.push_back(mp);
+      ++created;
+    }
+  }
+  std::lock_guard lock(stats_mutex_);
+  stats_.triangulated_points += created;
+}
+
+void LocalMapper::fuse_neighbours(const KeyFramePtr& kf) {
+  std::vector<KeyFramePtr> targets;
+  std::set<long> seen{kf->id()};
+  for (const auto& n : kf->best_covisibles(10)) {
+    if (n->is_bad() || !seen.insert(n->id()).second) continue;
+    targets.push_back(n);
+    for (const auto& n2 : n->best_covisibles(5))
+      if (!n2->is_bad() && seen.insert(n2->id()).second) targets.push_back(n2);
+  }
+  const std::vector<MapPointPtr> own = kf->map_points();
+  for (const auto& t : targets) fuse_into_keyframe(t, own);
+
+  std::vector<MapPointPtr> candidates;
+  std::set<long> cand_ids;
+  for (const auto& t : targets)
+    for (const auto& mp : t->map_points())
+      if (mp && !mp->is_bad() && cand_ids.insert(mp->id()).second) candidates.push_back(mp);
+  fuse_into_keyframe(kf, candidates);
+
+  for (const auto& mp : kf->map_points())
+    if (mp && !mp->is_bad()) {
+      mp->compute_descriptor();
+      mp->update_normal_and_depth(scale_->scale_factors);
+    }
+  kf->update_connections();
+}
+
+void LocalMapper::local_ba(const KeyFramePtr& kf) {
+  const auto t0 = Clock::now();
+  // Local window: the keyframe and its covisibles; fixed: others that see the window's points.
+  std::vector<KeyFramePtr> local{kf};
+  kf->ba_local_for_kf = kf->id();
+  for (const auto& n : kf->covisibles())
+    if (!n->is_bad()) {
+      n->ba_local_for_kf = kf->id();
+      local.push_back(n);
+    }
+  std::vector<MapPointPtr> points;
+  for (const auto& k : local)
+    for (const auto& mp : k->map_points())
+      if (mp && !mp->is_bad() && mp->ba_local_kf != kf->id()) {
+        mp->ba_local_kf = kf->id();
+        points.push_back(mp);
+      }
+  std::vector<KeyFramePtr> fixed;
+  for (const auto& mp : points)
+    for (const auto& [k, idx] : mp->observations())
+      if (k->ba_local_for_kf != kf->id() && k->ba_fixed_for_kf != kf->id() && !k->is_bad()) {
+        k->ba_fixed_for_kf = kf->id();
+        fixed.push_back(k);
+      }
+  if (local.size() < 2 && fixed.empty()) return;  // nothing anchors the gauge yet
+
+  optim::BaProblem problem;
+  std::map<long, int> kf_index;
+  const auto add_kf = [&](const KeyFramePtr& k, bool is_fixed) {
+    kf_index[k->id()] = static_cast<int>(problem.keyframes.size());
+    // The first keyframe of the map anchors the gauge when it is in the window.
+    problem.keyframes.push_back({k->pose(), is_fixed || k->id() == 0});
+  };
+  for (const auto& k : local) add_kf(k, false);
+  for (const auto& k : fixed) add_kf(k, true);
+  std::vector<std::pair<KeyFramePtr, MapPointPtr>> obs_owner;
+  for (std::size_t p = 0; p < points.size(); ++p) {
+    problem.points.push_back(points[p]->position());
+    for (const auto& [k, idx] : points[p]->observations()) {
+      auto it = kf_index.find(k->id());
+      if (it == kf_index.end() || k->is_bad()) continue;
+      const FrameFeatures& F = k->features();
+      optim::BaObservation o;
+      o.keyframe = it->second;
+      o.point = static_cast<int>(p);
+      o.obs.uv = {F.keypoints[idx].pt.x, F.keypoints[idx].pt.y};
+      o.obs.u_right = F.u_right[idx];
+      o.obs.inv_sigma2 = scale_->inv_level_sigma2[F.keypoints[idx].octave];
+      problem.observations.push_back(o);
+      obs_owner.emplace_back(k, points[p]);
+    }
+  }
+  bool any_free = false;
+  for (const auto& k : problem.keyframes) any_free |= !k.fixed;
+  if (!any_free || problem.observations.empty()) return;
+
+  optim::BaConfig bc;
+  bc.kernel = cfg_.kernel;
+  bc.outer_iterations = cfg_.ba_outer_iterations;
+  bc.iterations = cfg_.ba_iterations;
+  bc.refine_iterations = cfg_.ba_refine_iterations;
+  const PinholeCamera& cam = kf->features().camera;
+  const optim::BaResult res = optim::solve_local_ba(cam, problem, bc);
+
+  int outliers = 0;
+  {
+    // Write back under the map's update lock: tracking never sees a half-updated window.
+    std::unique_lock lock(map_.update_mutex());
+    for (std::size_t i = 0; i < local.size(); ++i)
+      if (!problem.keyframes[i].fixed) local[i]->set_pose(problem.keyframes[i].T_cw);
+    for (std::size_t p = 0; p < points.size(); ++p) points[p]->set_position(problem.points[p]);
+    for (std::size_t o = 0; o < res.outlier_observation.size(); ++o) {
+      if (!res.outlier_observation[o]) continue;
+      const auto& [k, mp] = obs_owner[o];
+      const int idx = mp->index_in(k.get());
+      if (idx >= 0) k->erase_map_point(idx);
+      mp->erase_observation(k);
+      ++outliers;
+    }
+  }
+  for (const auto& mp : points)
+    if (!mp->is_bad()) mp->update_normal_and_depth(scale_->scale_factors);
+
+  BaRecord rec;
+  rec.keyframe_id = kf->id();
+  rec.timestamp = kf->timestamp();
+  rec.keyframes = static_cast<int>(local.size());
+  rec.fixed_keyframes = static_cast<int>(fixed.size());
+  rec.points = static_cast<int>(points.size());
+  rec.observations = static_cast<int>(problem.observations.size());
+  rec.outliers = outliers;
+  rec.alpha_per_iteration = res.alpha_per_iteration;
+  rec.final_alpha = res.final_alpha;
+  rec.ms = ms_since(t0);
+  std::lock_guard lock(stats_mutex_);
+  stats_.ba.push_back(std::move(rec));
+}
+
+void LocalMapper::cull_keyframes(const KeyFramePtr& kf) {
+  constexpr int kRedundantObservers = 3;
+  int culled = 0;
+  for (const auto& k : kf->covisibles()) {
+    if (k->id() == 0 || k->is_bad()) continue;
+    const auto points = k->map_points();
+    const FrameFeatures& F = k->features();
+    int n_points = 0, n_redundant = 0;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const MapPointPtr& mp = points[i];
+      if (!mp || mp->is_bad() || !F.is_close(i)) continue;  // RGB-D: judge by the reliable close points
+      ++n_points;
+      if (mp->num_observations() <= kRedundantObservers) continue;
+      const int level = F.keypoints[i].octave;
+      int observers = 0;
+      for (const auto& [other, idx] : mp->observations()) {
+        if (other == k || other->is_bad()) continue;
+        if (other->features().keypoints[idx].octave <= level + 1 && ++observers >= kRedundantObservers) break;
+      }
+      if (observers >= kRedundantObservers) ++n_redundant;
+    }
+    if (n_points > 0 && n_redundant > cfg_.keyframe_redundancy * n_points) {
+      k->set_bad();
+      map_.erase_keyframe(k);
+      ++culled;
+    }
+  }
+  std::lock_guard lock(stats_mutex_);
+  stats_.culled_keyframes += culled;
+}
+
+void LocalMapper::remove_bad_from_map() {
+  for (const auto& mp : map_.map_points())
+    if (mp->is_bad()) map_.erase_map_point(mp);
+  for (const auto& k : map_.keyframes())
+    if (k->is_bad()) map_.erase_keyframe(k);
+}
+
+}  // namespace varslam::slam

@@ -1,0 +1,85 @@
+#pragma once
+// Local mapping: grows and cleans the map around each new keyframe (observations, new points from
+// triangulation, fusion of duplicates, Local BA, culling of weak points and redundant keyframes).
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <list>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "slam/config.hpp"
+#include "slam/map.hpp"
+#include "slam/tracking.hpp"
+
+namespace varslam::slam {
+
+/// What one Local BA did (for the run's metrics and the alpha-per-keyframe plot).
+struct BaRecord {
+  long keyframe_id = 0;
+  double timestamp = 0;
+  int keyframes = 0, fixed_keyframes = 0, points = 0, observations = 0, outliers = 0;
+  std::vector<double> alpha_per_iteration;
+  double final_alpha = 2.0;
+  double ms = 0;
+};
+
+struct MappingStats {
+  std::vector<double> keyframe_ms;  // whole processing of one keyframe
+  std::vector<BaRecord> ba;
+  int triangulated_points = 0;
+  int culled_points = 0;
+  int culled_keyframes = 0;
+};
+
+class LocalMapper final : public KeyframeSink {
+ public:
+  LocalMapper(const MappingConfig& cfg, Map& map, std::shared_ptr<const ScaleInfo> scale, double close_depth);
+  ~LocalMapper() override;
+
+  // KeyframeSink
+  bool accepts_keyframes() const override;
+  std::size_t queued() const override;
+  void insert(const KeyFramePtr& kf) override;
+  void interrupt_ba() override { abort_ba_ = true; }
+
+  /// Deterministic mode: process every queued keyframe now, in the caller's thread.
+  void process_all();
+  /// Real-time mode: process keyframes on an own thread until stop().
+  void start();
+  /// Finishes the queued keyframes and joins the thread.
+  void stop();
+
+  MappingStats stats() const;
+
+ private:
+  void run();
+  void process(const KeyFramePtr& kf);
+  void add_observations(const KeyFramePtr& kf);
+  void cull_recent_points(const KeyFramePtr& kf);
+  void triangulate(const KeyFramePtr& kf);
+  void fuse_neighbours(const KeyFramePtr& kf);
+  void local_ba(const KeyFramePtr& kf);
+  void cull_keyframes(const KeyFramePtr& kf);
+  void remove_bad_from_map();
+
+  MappingConfig cfg_;
+  Map& map_;
+  std::shared_ptr<const ScaleInfo> scale_;
+  double close_depth_;
+
+  mutable std::mutex queue_mutex_;
+  std::condition_variable queue_cv_;
+  std::deque<KeyFramePtr> queue_;
+  std::atomic<bool> busy_{false};
+  std::atomic<bool> abort_ba_{false};
+  std::atomic<bool> stop_requested_{false};
+  std::thread thread_;
+
+  std::list<MapPointPtr> recent_points_;
+  mutable std::mutex stats_mutex_;
+  MappingStats stats_;
+};
+
+}  // namespace varslam::slam

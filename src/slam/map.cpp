@@ -1,0 +1,58 @@
+#include "slam/map.hpp"
+
+namespace varslam::slam {
+
+void Map::add_keyframe(const KeyFramePtr& kf) {
+  std::lock_guard lock(mutex_);
+  keyframes_.insert(kf);
+}
+
+void Map::add_map_point(const MapPointPtr& mp) {
+  std::lock_guard lock(mutex_);
+  map_points_.insert(mp);
+}
+
+void Map::erase_keyframe(const KeyFramePtr& kf) {
+  std::lock_guard lock(mutex_);
+  keyframes_.erase(kf);
+}
+
+void Map::erase_map_point(const MapPointPtr& mp) {
+  std::lock_guard lock(mutex_);
+  map_points_.erase(mp);
+}
+
+std::vector<KeyFramePtr> Map::keyframes() const {
+  std::lock_guard lock(mutex_);
+  return {keyframes_.begin(), keyframes_.end()};
+}
+
+std::vector<MapPointPtr> Map::map_points() const {
+  std::lock_guard lock(mutex_);
+  return {map_points_.begin(), map_points_.end()};
+}
+
+std::size_t Map::num_keyframes() const {
+  std::lock_guard lock(mutex_);
+  return keyframes_.size();
+}
+
+std::size_t Map::num_map_points() const {
+  std::lock_guard lock(mutex_);
+  return map_points_.size();
+}
+
+void Map::clear() {
+  std::set<KeyFramePtr, IdLess> kfs;
+  std::set<MapPointPtr, IdLess> mps;
+  {
+    std::lock_guard lock(mutex_);
+    kfs.swap(keyframes_);
+    mps.swap(map_points_);
+  }
+  // Setting every point bad drops the keyframe->point and point->keyframe references.
+  for (const auto& mp : mps) mp->set_bad();
+  for (const auto& kf : kfs) kf->clear_graph();
+}
+
+}  // namespace varslam::slam

@@ -1,0 +1,34 @@
+#pragma once
+// Matching by projection: map points are projected with a predicted pose and matched to keypoints near
+// the projection by descriptor distance (the SLAM-specific searches; plain descriptor tools live in features/).
+#include <Eigen/Geometry>
+#include <vector>
+
+#include "slam/frame.hpp"
+#include "slam/keyframe.hpp"
+
+namespace varslam::slam {
+
+inline constexpr int kDescDistHigh = 100;  // loosest accepted Hamming distance (of 256 bits)
+inline constexpr int kDescDistLow = 50;    // strict distance for fusing and triangulation
+
+/// Matches the map points of `last` into `cur` (whose T_cw holds the prediction). `radius` in pixels at level
+/// 0, scaled by the keypoint's level. Returns the number of new matches.
+int match_last_frame(Frame& cur, const Frame& last, double radius);
+
+/// Projects local map points into `cur` (frustum and viewing-angle checks, scale prediction) and matches the
+/// ones not matched yet. Marks visited points visible. `radius_scale` widens the search (e.g. after a loss).
+int match_local_map(Frame& cur, const std::vector<MapPointPtr>& points, double radius_scale);
+
+/// Descriptor matching of the keyframe's map points against all of the frame's keypoints (ratio test,
+/// rotation consistency); the fallback when the motion model fails.
+int match_keyframe_by_descriptor(Frame& cur, const KeyFrame& kf);
+
+/// Projects `points` into `kf` and either adds them as new observations or fuses them with the point
+/// already there (the one with more observations survives). Returns the number fused or added.
+int fuse_into_keyframe(const KeyFramePtr& kf, const std::vector<MapPointPtr>& points, double radius = 3.0);
+
+/// Pairs of unmatched keypoints (idx1 in kf1, idx2 in kf2) that agree in descriptor and epipolar geometry.
+std::vector<std::pair<int, int>> match_for_triangulation(const KeyFrame& kf1, const KeyFrame& kf2);
+
+}  // namespace varslam::slam

@@ -1,0 +1,58 @@
+#pragma once
+// The SLAM system: wires tracking and local mapping, in one of two modes.
+//  - deterministic: stages run in order in the caller's thread (same input, same output);
+//  - real-time: local mapping on its own thread, frames decoded ahead by the prefetcher, tracking in the
+//    caller's thread, optionally paced at the dataset's frame rate.
+#include <memory>
+#include <vector>
+
+#include "core/trajectory.hpp"
+#include "slam/local_mapping.hpp"
+#include "slam/tracking.hpp"
+
+namespace varslam::slam {
+
+enum class RunMode { Deterministic, RealTime };
+
+/// Per-frame log entry for the metrics.
+struct FrameLog {
+  double timestamp = 0;
+  TrackState state = TrackState::NotInitialized;
+  bool keyframe = false, new_segment = false;
+  int keypoints = 0, inliers = 0;
+  double load_ms = 0;
+  FrameTimings timings;
+};
+
+class System {
+ public:
+  System(const SlamConfig& cfg, const PinholeCamera& camera, double close_depth, RunMode mode);
+  ~System();
+  System(const System&) = delete;
+  System& operator=(const System&) = delete;
+
+  /// Tracks one frame (and, in deterministic mode, runs local mapping on any keyframe it made).
+  TrackOutcome process(const RgbdFrame& frame);
+  /// Finishes local mapping (real-time mode) so the map is final.
+  void finish();
+
+  void set_keypoint_filter(KeypointFilterFn fn) { tracker_.set_keypoint_filter(std::move(fn)); }
+
+  /// Camera-to-world pose of every processed frame that has one (tracked, or re-anchored to a new segment).
+  Trajectory camera_trajectory(bool include_lost = false) const;
+  Trajectory keyframe_trajectory() const;
+  const Map& map() const { return map_; }
+  Map& map() { return map_; }
+  const Tracker& tracker() const { return tracker_; }
+  MappingStats mapping_stats() const { return mapper_.stats(); }
+  RunMode mode() const { return mode_; }
+
+ private:
+  SlamConfig cfg_;
+  RunMode mode_;
+  Map map_;
+  LocalMapper mapper_;
+  Tracker tracker_;
+};
+
+}  // namespace varslam::slam

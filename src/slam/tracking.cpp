@@ -1,0 +1,429 @@
+#include "slam/tracking.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <mutex>
+#include <shared_mutex>
+
+#include "optim/pose_optimizer.hpp"
+#include "slam/matcher.hpp"
+
+namespace varslam::slam {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+constexpr int kMinKeypointsToInitialize = 500;  // enough structure to start a map (ORB-SLAM's rule)
+constexpr int kMinInliersMotion = 10;
+
+}  // namespace
+
+Tracker::Tracker(const SlamConfig& cfg, const PinholeCamera& camera, double close_depth, Map& map, KeyframeSink& sink)
+    : cfg_(cfg), camera_(camera), close_depth_(close_depth), map_(map), sink_(sink),
+      extractor_(make_extractor(cfg.orb, cfg.extractor)) {
+  auto s = std::make_shared<ScaleInfo>();
+  s->n_levels = extractor_->n_levels();
+  s->scale_factor = extractor_->scale_factor();
+  s->log_scale_factor = std::log(s->scale_factor);
+  s->scale_factors = extractor_->scale_factors();
+  s->level_sigma2 = extractor_->level_sigma2();
+  s->inv_level_sigma2 = extractor_->inv_level_sigma2();
+  scale_ = s;
+}
+
+Frame Tracker::build_frame(const RgbdFrame& input, FrameTimings& t) {
+  auto t0 = Clock::now();
+  std::vector<cv::KeyPoint> kps;
+  cv::Mat desc;
+  extractor_->extract(input.gray, kps, desc);
+  t.extract_ms = ms_since(t0);
+  if (filter_ && !kps.empty()) {
+    t0 = Clock::now();
+    const std::vector<bool> keep = filter_(input, kps);
+    std::vector<cv::KeyPoint> kept;
+    cv::Mat kept_desc;
+    kept.reserve(kps.size());
+    for (std::size_t i = 0; i < kps.size(); ++i)
+      if (keep[i]) {
+        kept.push_back(kps[i]);
+        kept_desc.push_back(desc.row(static_cast<int>(i)));
+      }
+    kps.swap(kept);
+    desc = kept_desc;
+    t.filter_ms = ms_since(t0);
+  }
+  auto features = make_frame_features(std::move(kps), desc, input.depth, camera_, close_depth_, scale_);
+  return Frame(next_frame_id_++, input.timestamp, std::move(features));
+}
+
+TrackOutcome Tracker::track(const RgbdFrame& input) {
+  TrackOutcome out;
+  const auto t_start = Clock::now();
+  Frame cur = build_frame(input, out.timings);
+  out.keypoints = static_cast<int>(cur.features->size());
+
+  std::shared_lock map_lock(map_.update_mutex());
+  if (state_ == TrackState::NotInitialized) {
+    if (initialize(cur, Eigen::Isometry3d::Identity())) {
+      state_ = TrackState::Ok;
+      out.keyframe = true;
+    }
+    record(cur, state_ == TrackState::Ok);
+    out.state = state_;
+    out.timings.track_ms = ms_since(t_start);
+    last_ = cur;
+    return out;
+  }
+
+  bool ok = false;
+  if (state_ == TrackState::Ok) {
+    refresh_last_frame();
+    if (has_velocity_) ok = track_motion_model(cur, out.timings);
+    if (!ok) ok = track_reference_keyframe(cur, reference_kf_, out.timings);
+  } else {
+    refresh_last_frame();
+    ok = recover(cur, out.timings);
+  }
+  if (ok) ok = track_local_map(cur, out.timings);
+
+  if (ok) {
+    state_ = TrackState::Ok;
+    lost_count_ = 0;
+    velocity_ = cur.T_cw * last_.T_cw.inverse();
+    has_velocity_ = true;
+    clean_temporary_matches(cur);
+    for (std::size_t i = 0; i < cur.map_points.size(); ++i)
+      if (cur.map_points[i] && cur.outlier[i]) cur.map_points[i].reset();
+    out.inliers = cur.num_tracked();
+    if (need_keyframe(cur, out.inliers)) {
+      create_keyframe(cur);
+      out.keyframe = true;
+    }
+    record(cur, true);
+  } else {
+    // Lost: keep predicting with the motion model; after a few failed recoveries start a new map segment at
+    // the predicted pose so the trajectory goes on (loop closing will bring real relocalization).
+    ++lost_count_;
+    state_ = TrackState::Lost;
+    cur.T_cw = (has_velocity_ ? velocity_ : Eigen::Isometry3d::Identity()) * last_.T_cw;
+    std::fill(cur.map_points.begin(), cur.map_points.end(), nullptr);
+    if (lost_count_ > cfg_.tracking.lost_frames_before_reinit && initialize(cur, cur.T_cw)) {
+      spdlog::warn("tracking lost for {} frames at t={:.3f}: new map segment started", lost_count_, cur.timestamp);
+      state_ = TrackState::Ok;
+      lost_count_ = 0;
+      has_velocity_ = false;
+      out.keyframe = true;
+      out.new_segment = true;
+      record(cur, true);
+    } else {
+      cur.reference_kf = reference_kf_;
+      record(cur, false);
+    }
+  }
+  out.state = state_;
+  last_ = cur;
+  last_is_keyframe_ = out.keyframe;
+  out.timings.track_ms = ms_since(t_start);
+  return out;
+}
+
+bool Tracker::initialize(Frame& cur, const Eigen::Isometry3d& T_cw) {
+  if (static_cast<int>(cur.features->size()) < kMinKeypointsToInitialize) return false;
+  int with_depth = 0;
+  for (std::size_t i = 0; i < cur.features->size(); ++i) with_depth += cur.features->has_depth(i);
+  if (with_depth < kMinKeypointsToInitialize / 2) return false;
+  cur.T_cw = T_cw;
+  cur.has_pose = true;
+  std::fill(cur.map_points.begin(), cur.map_points.end(), nullptr);
+  insert_keyframe_with_depth_points(cur, true);
+  ++segments_;
+  last_is_keyframe_ = true;
+  spdlog::debug("map segment {} initialised with {} points", segments_, cur.num_tracked());
+  return true;
+}
+
+void Tracker::refresh_last_frame() {
+  // The reference keyframe may have moved (Local BA): re-anchor the last pose to it.
+  if (last_.reference_kf && !last_is_keyframe_) last_.T_cw = last_T_c_ref_ * last_.reference_kf->pose();
+  if (last_is_keyframe_ || state_ != TrackState::Ok) return;
+  // RGB-D visual odometry: temporary points from the last frame's depth give the motion model more matches.
+  const FrameFeatures& L = *last_.features;
+  std::vector<std::pair<float, int>> by_depth;
+  for (std::size_t i = 0; i < L.size(); ++i)
+    if (L.has_depth(i)) by_depth.emplace_back(L.depth[i], static_cast<int>(i));
+  std::sort(by_depth.begin(), by_depth.end());
+  const Eigen::Isometry3d T_wc = last_.T_cw.inverse();
+  int n = 0;
+  for (const auto& [d, i] : by_depth) {
+    const MapPointPtr& mp = last_.map_points[i];
+    if (!mp || mp->num_observations() < 1) {
+      auto tmp = std::make_shared<MapPoint>(-1, T_wc * L.unproject(i), nullptr);
+      tmp->set_descriptor(L.descriptors.row(i));
+      last_.map_points[i] = tmp;
+      last_.outlier[i] = false;
+    }
+    ++n;
+    if (d > close_depth_ && n > cfg_.tracking.vo_points) break;
+  }
+}
+
+int Tracker::optimize_and_discard(Frame& cur, FrameTimings& t) {
+  const auto t0 = Clock::now();
+  std::vector<Eigen::Vector3d> pts;
+  std::vector<optim::Observation> obs;
+  std::vector<int> idx;
+  const FrameFeatures& F = *cur.features;
+  for (std::size_t i = 0; i < cur.map_points.size(); ++i) {
+    const MapPointPtr& mp = cur.map_points[i];
+    if (!mp) continue;
+    pts.push_back(mp->position());
+    optim::Observation o;
+    o.uv = {F.keypoints[i].pt.x, F.keypoints[i].pt.y};
+    o.u_right = F.u_right[i];
+    o.inv_sigma2 = F.scale->inv_level_sigma2[F.keypoints[i].octave];
+    obs.push_back(o);
+    idx.push_back(static_cast<int>(i));
+  }
+  if (obs.size() < 3) return 0;
+  optim::PoseOptimConfig pc;
+  pc.kernel = cfg_.tracking.kernel;
+  const auto res = optim::optimize_pose(camera_, cur.T_cw, pts, obs, pc);
+  cur.has_pose = true;
+  int inliers = 0;
+  for (std::size_t k = 0; k < idx.size(); ++k) {
+    cur.outlier[idx[k]] = res.outlier[k];
+    if (!res.outlier[k] && cur.map_points[idx[k]]->num_observations() > 0) ++inliers;
+  }
+  t.pose_ms += ms_since(t0);
+  return inliers;
+}
+
+bool Tracker::track_motion_model(Frame& cur, FrameTimings& t) {
+  auto t0 = Clock::now();
+  cur.T_cw = velocity_ * last_.T_cw;
+  std::fill(cur.map_points.begin(), cur.map_points.end(), nullptr);
+  int n = match_last_frame(cur, last_, cfg_.tracking.motion_radius);
+  if (n < cfg_.tracking.min_matches) {
+    std::fill(cur.map_points.begin(), cur.map_points.end(), nullptr);
+    n = match_last_frame(cur, last_, 2 * cfg_.tracking.motion_radius);
+  }
+  t.match_ms += ms_since(t0);
+  if (n < cfg_.tracking.min_matches) return false;
+  optimize_and_discard(cur, t);
+  int inliers = 0;
+  for (std::size_t i = 0; i < cur.map_points.size(); ++i) {
+    if (!cur.map_points[i]) continue;
+    if (cur.outlier[i]) {
+      cur.map_points[i]->last_seen_frame = cur.id;
+      cur.map_points[i].reset();
+      cur.outlier[i] = false;
+    } else {
+      ++inliers;  // temporary VO points count here, as they carry real depth
+    }
+  }
+  cur.reference_kf = reference_kf_;
+  return inliers >= kMinInliersMotion;
+}
+
+bool Tracker::track_reference_keyframe(Frame& cur, const KeyFramePtr& kf, FrameTimings& t) {
+  if (!kf) return false;
+  auto t0 = Clock::now();
+  cur.T_cw = last_.T_cw;
+  std::fill(cur.map_points.begin(), cur.map_points.end(), nullptr);
+  const int n = match_keyframe_by_descriptor(cur, *kf);
+  t.match_ms += ms_since(t0);
+  if (n < 15) return false;
+  optimize_and_discard(cur, t);
+  int inliers = 0;
+  for (std::size_t i = 0; i < cur.map_points.size(); ++i) {
+    if (!cur.map_points[i]) continue;
+    if (cur.outlier[i]) {
+      cur.map_points[i].reset();
+      cur.outlier[i] = false;
+    } else if (cur.map_points[i]->num_observations() > 0) {
+      ++inliers;
+    }
+  }
+  cur.reference_kf = kf;
+  return inliers >= kMinInliersMotion;
+}
+
+bool Tracker::recover(Frame& cur, FrameTimings& t) {
+  // Try the keyframes around the last reference, best first, from the motion-model prediction.
+  if (!reference_kf_) return false;
+  std::vector<KeyFramePtr> candidates{reference_kf_};
+  for (const auto& kf : reference_kf_->best_covisibles(5)) candidates.push_back(kf);
+  const Eigen::Isometry3d predicted = (has_velocity_ ? velocity_ : Eigen::Isometry3d::Identity()) * last_.T_cw;
+  for (const auto& kf : candidates) {
+    if (kf->is_bad()) continue;
+    last_.T_cw = predicted;
+    if (track_reference_keyframe(cur, kf, t)) {
+      last_recovery_frame_id_ = cur.id;
+      reference_kf_ = kf;
+      spdlog::info("tracking recovered at t={:.3f} against keyframe {}", cur.timestamp, kf->id());
+      return true;
+    }
+  }
+  return false;
+}
+
+void Tracker::update_local_map(Frame& cur) {
+  // Keyframes that see the current matches, weighted by how many they see.
+  std::map<KeyFramePtr, int, IdLess> counter;
+  for (std::size_t i = 0; i < cur.map_points.size(); ++i) {
+    const MapPointPtr& mp = cur.map_points[i];
+    if (!mp || mp->is_bad()) continue;
+    for (const auto& [kf, idx] : mp->observations()) counter[kf]++;
+  }
+  local_keyframes_.clear();
+  KeyFramePtr best;
+  int best_count = 0;
+  for (const auto& [kf, c] : counter) {
+    if (kf->is_bad()) continue;
+    if (c > best_count) {
+      best_count = c;
+      best = kf;
+    }
+    local_keyframes_.push_back(kf);
+    kf->local_for_frame = cur.id;
+  }
+  // Add neighbours: best covisibles, children and parent of each, up to the budget.
+  const std::size_t direct = local_keyframes_.size();
+  for (std::size_t k = 0; k < direct && local_keyframes_.size() < static_cast<std::size_t>(cfg_.tracking.max_local_keyframes); ++k) {
+    const KeyFramePtr kf = local_keyframes_[k];
+    auto add = [&](const KeyFramePtr& n) {
+      if (n && !n->is_bad() && n->local_for_frame != cur.id) {
+        n->local_for_frame = cur.id;
+        local_keyframes_.push_back(n);
+        return true;
+      }
+      return false;
+    };
+    for (const auto& n : kf->best_covisibles(10))
+      if (add(n)) break;
+    for (const auto& c : kf->children())
+      if (add(c)) break;
+    add(kf->parent());
+  }
+  if (best) {
+    reference_kf_ = best;
+    cur.reference_kf = best;
+  }
+  local_points_.clear();
+  for (const auto& kf : local_keyframes_)
+    for (const auto& mp : kf->map_points()) {
+      if (!mp || mp->is_bad() || mp->track_reference_frame == cur.id) continue;
+      mp->track_reference_frame = cur.id;
+      local_points_.push_back(mp);
+    }
+}
+
+bool Tracker::track_local_map(Frame& cur, FrameTimings& t) {
+  auto t0 = Clock::now();
+  update_local_map(cur);
+  for (std::size_t i = 0; i < cur.map_points.size(); ++i) {
+    const MapPointPtr& mp = cur.map_points[i];
+    if (!mp) continue;
+    mp->last_seen_frame = cur.id;
+    mp->increase_visible();
+  }
+  const bool recently_recovered = cur.id < last_recovery_frame_id_ + 2;
+  match_local_map(cur, local_points_, recently_recovered ? 2.0 : 1.0);
+  t.match_ms += ms_since(t0);
+  optimize_and_discard(cur, t);
+  int inliers = 0;
+  for (std::size_t i = 0; i < cur.map_points.size(); ++i) {
+    const MapPointPtr& mp = cur.map_points[i];
+    if (!mp || cur.outlier[i]) continue;
+    mp->increase_found();
+    if (mp->num_observations() > 0) ++inliers;
+  }
+  const int needed = recently_recovered ? 50 : cfg_.tracking.min_inliers_local_map;
+  return inliers >= needed;
+}
+
+void Tracker::clean_temporary_matches(Frame& cur) {
+  for (auto& mp : cur.map_points)
+    if (mp && mp->num_observations() < 1 && mp->id() < 0) mp.reset();
+}
+
+bool Tracker::need_keyframe(const Frame& cur, int inliers) const {
+  if (!reference_kf_) return true;
+  const std::size_t n_kfs = map_.num_keyframes();
+  const int min_obs = n_kfs <= 2 ? 2 : 3;
+  const int ref_matches = reference_kf_->tracked_map_points(min_obs);
+  const bool mapping_idle = sink_.accepts_keyframes();
+  const FrameFeatures& F = *cur.features;
+  int tracked_close = 0, untracked_close = 0;
+  for (std::size_t i = 0; i < F.size(); ++i) {
+    if (!F.is_close(i)) continue;
+    if (cur.map_points[i] && !cur.outlier[i]) ++tracked_close;
+    else ++untracked_close;
+  }
+  // Many close points seen but few of them in the map: a keyframe adds cheap, well-constrained structure.
+  const bool need_close = tracked_close < 100 && untracked_close > 70;
+  const double ref_ratio = n_kfs < 2 ? 0.4 : 0.75;
+  const long max_frames = std::max<long>(1, std::lround(cfg_.fps));
+  const bool c1a = cur.id >= last_kf_frame_id_ + max_frames;
+  const bool c1b = mapping_idle;
+  const bool c1c = inliers < ref_matches * 0.25 || need_close;
+  const bool c2 = (inliers < ref_matches * ref_ratio || need_close) && inliers > 15;
+  if (!((c1a || c1b || c1c) && c2)) return false;
+  if (mapping_idle) return true;
+  sink_.interrupt_ba();
+  return sink_.queued() < 3;
+}
+
+void Tracker::create_keyframe(Frame& cur) { insert_keyframe_with_depth_points(cur, false); }
+
+KeyFramePtr Tracker::insert_keyframe_with_depth_points(Frame& cur, bool all_depth_points) {
+  auto kf = std::make_shared<KeyFrame>(map_.next_keyframe_id(), cur);
+  const FrameFeatures& F = *cur.features;
+  std::vector<std::pair<float, int>> by_depth;
+  for (std::size_t i = 0; i < F.size(); ++i)
+    if (F.has_depth(i)) by_depth.emplace_back(F.depth[i], static_cast<int>(i));
+  std::sort(by_depth.begin(), by_depth.end());
+  const Eigen::Isometry3d T_wc = cur.T_cw.inverse();
+  int n = 0;
+  for (const auto& [d, i] : by_depth) {
+    const MapPointPtr& existing = cur.map_points[i];
+    if (!existing || existing->num_observations() < 1) {
+      auto mp = std::make_shared<MapPoint>(map_.next_map_point_id(), T_wc * F.unproject(i), kf);
+      mp->add_observation(kf, i, true);
+      kf->add_map_point(mp, i);
+      mp->compute_descriptor();
+      mp->update_normal_and_depth(scale_->scale_factors);
+      map_.add_map_point(mp);
+      cur.map_points[i] = mp;
+      cur.outlier[i] = false;
+    }
+    ++n;
+    if (!all_depth_points && d > close_depth_ && n > 100) break;
+  }
+  map_.add_keyframe(kf);
+  cur.reference_kf = kf;
+  reference_kf_ = kf;
+  last_kf_frame_id_ = cur.id;
+  sink_.insert(kf);
+  return kf;
+}
+
+void Tracker::record(const Frame& cur, bool tracked) {
+  FrameRecord r;
+  r.timestamp = cur.timestamp;
+  r.tracked = tracked;
+  r.reference = cur.reference_kf;
+  if (r.reference) r.T_c_ref = cur.T_cw * r.reference->pose_inverse();
+  else r.T_c_ref = cur.T_cw;
+  records_.push_back(r);
+  if (&cur != &last_) last_T_c_ref_ = r.T_c_ref;
+}
+
+}  // namespace varslam::slam

@@ -1,0 +1,108 @@
+#pragma once
+// Tracking: estimates the pose of every frame against the map (motion model, reference keyframe, local map)
+// and decides when a frame becomes a keyframe. Owns the current and last frame; reads the map.
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "core/rgbd_frame.hpp"
+#include "features/feature_extractor.hpp"
+#include "slam/config.hpp"
+#include "slam/frame.hpp"
+#include "slam/keyframe.hpp"
+#include "slam/map.hpp"
+
+namespace varslam::slam {
+
+enum class TrackState { NotInitialized, Ok, Lost };
+
+/// Where tracking hands its keyframes (local mapping, directly or through a queue).
+class KeyframeSink {
+ public:
+  virtual ~KeyframeSink() = default;
+  virtual bool accepts_keyframes() const = 0;  // idle, ready for the next one
+  virtual std::size_t queued() const = 0;
+  virtual void insert(const KeyFramePtr& kf) = 0;
+  virtual void interrupt_ba() = 0;
+};
+
+/// Decides which keypoints tracking may use (the semantic filter plugs in here). keep[i] per keypoint.
+using KeypointFilterFn = std::function<std::vector<bool>(const RgbdFrame&, const std::vector<cv::KeyPoint>&)>;
+
+struct FrameTimings {
+  double extract_ms = 0, filter_ms = 0, match_ms = 0, pose_ms = 0, track_ms = 0;
+};
+
+struct TrackOutcome {
+  TrackState state = TrackState::NotInitialized;
+  bool keyframe = false;
+  bool new_segment = false;  // tracking was lost and a new map segment started at the predicted pose
+  int inliers = 0;
+  int keypoints = 0;
+  FrameTimings timings;
+};
+
+/// Pose of a frame kept relative to its reference keyframe, so later keyframe corrections (BA) move it too.
+struct FrameRecord {
+  double timestamp = 0;
+  KeyFramePtr reference;
+  Eigen::Isometry3d T_c_ref = Eigen::Isometry3d::Identity();
+  bool tracked = false;
+};
+
+class Tracker {
+ public:
+  Tracker(const SlamConfig& cfg, const PinholeCamera& camera, double close_depth, Map& map, KeyframeSink& sink);
+
+  TrackOutcome track(const RgbdFrame& input);
+  void set_keypoint_filter(KeypointFilterFn fn) { filter_ = std::move(fn); }
+
+  TrackState state() const { return state_; }
+  const std::vector<FrameRecord>& records() const { return records_; }
+  const Frame& last_frame() const { return last_; }
+  int segments() const { return segments_; }
+  std::shared_ptr<const ScaleInfo> scale() const { return scale_; }
+
+ private:
+  Frame build_frame(const RgbdFrame& input, FrameTimings& t);
+  bool initialize(Frame& cur, const Eigen::Isometry3d& T_cw);
+  void refresh_last_frame();
+  bool track_motion_model(Frame& cur, FrameTimings& t);
+  bool track_reference_keyframe(Frame& cur, const KeyFramePtr& kf, FrameTimings& t);
+  bool recover(Frame& cur, FrameTimings& t);
+  bool track_local_map(Frame& cur, FrameTimings& t);
+  int optimize_and_discard(Frame& cur, FrameTimings& t);
+  void update_local_map(Frame& cur);
+  bool need_keyframe(const Frame& cur, int inliers) const;
+  void create_keyframe(Frame& cur);
+  KeyFramePtr insert_keyframe_with_depth_points(Frame& cur, bool all_depth_points);
+  void clean_temporary_matches(Frame& cur);
+  void record(const Frame& cur, bool tracked);
+
+  SlamConfig cfg_;
+  PinholeCamera camera_;
+  double close_depth_;
+  Map& map_;
+  KeyframeSink& sink_;
+  std::unique_ptr<FeatureExtractor> extractor_;
+  std::shared_ptr<const ScaleInfo> scale_;
+  KeypointFilterFn filter_;
+
+  TrackState state_ = TrackState::NotInitialized;
+  long next_frame_id_ = 0;
+  Frame last_;
+  Eigen::Isometry3d last_T_c_ref_ = Eigen::Isometry3d::Identity();
+  bool last_is_keyframe_ = false;
+  Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();
+  bool has_velocity_ = false;
+  KeyFramePtr reference_kf_;
+  long last_kf_frame_id_ = 0;
+  long last_recovery_frame_id_ = -1000;
+  int lost_count_ = 0;
+  int segments_ = 0;
+  std::vector<KeyFramePtr> local_keyframes_;
+  std::vector<MapPointPtr> local_points_;
+  std::vector<FrameRecord> records_;
+};
+
+}  // namespace varslam::slam

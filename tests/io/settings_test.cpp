@@ -1,0 +1,271 @@
+#include "io/settings.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "core/error.hpp"
+#include "io/temp_dir.hpp"
+
+namespace varslam {
+namespace {
+
+using ::testing::AllOf;
+using ::testing::HasSubstr;
+using varslam::testing::TempDir;
+
+// Runs fn, expects a ConfigError, returns its message.
+template <typename Fn>
+std::string config_error(Fn&& fn) {
+  try {
+    fn();
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "expected a ConfigError";
+  return {};
+}
+
+const char* kOurs = R"(camera:
+  fx: 500.5
+  fy: 501.25
+  cx: 320
+  cy: 240
+  width: 640
+  height: 480
+  fps: 30
+  baseline: 0.08
+depth: {factor: 5000, th_depth: 40}
+orb: {n_features: 1000, scale_factor: 1.2, n_levels: 8, ini_th_fast: 20, min_th_fast: 7}
+)";
+
+TEST(Settings, DefaultsAreTumFr1Like) {
+  const Settings s = default_settings();
+  EXPECT_DOUBLE_EQ(s.camera.fx, 517.3);
+  EXPECT_DOUBLE_EQ(s.camera.fy, 516.5);
+  EXPECT_DOUBLE_EQ(s.camera.cx, 318.6);
+  EXPECT_DOUBLE_EQ(s.camera.cy, 255.3);
+  EXPECT_EQ(s.camera.width, 640);
+  EXPECT_EQ(s.camera.height, 480);
+  EXPECT_DOUBLE_EQ(s.camera.bf, 40.0);
+  EXPECT_DOUBLE_EQ(s.depth_factor, 5000.0);
+  EXPECT_DOUBLE_EQ(s.th_depth, 40.0);
+  EXPECT_DOUBLE_EQ(s.fps, 30.0);
+  EXPECT_FALSE(s.camera.has_distortion());
+  EXPECT_TRUE(s.source.empty());
+  EXPECT_NEAR(s.close_depth_m(), 40.0 * 40.0 / 517.3, 1e-12);
+}
+
+TEST(Settings, OurLayoutRoundTripKeepsEveryFieldAndStageSections) {
+  TempDir dir;
+  Settings s = default_settings();
+  s.camera.fx = 612.25;
+  s.camera.fy = 611.5;
+  s.camera.cx = 330.125;
+  s.camera.cy = 241.75;
+  s.camera.k1 = 0.1;
+  s.camera.k2 = -0.02;
+  s.camera.p1 = 0.001;
+  s.camera.p2 = -0.002;
+  s.camera.k3 = 0.0003;
+  s.camera.width = 848;
+  s.camera.height = 480;
+  s.camera.bf = 612.25 * 0.05;
+  s.fps = 15;
+  s.depth_factor = 1000;
+  s.th_depth = 35.5;
+  s.orb = {1500, 1.25, 6, 18, 5};
+  s.root = YAML::Load("tracking: {kernel: barron, iterations: 7, robust: true}\nmapping: {window: 12.5}\n");
+  const auto file = dir / "settings.yaml";
+  save_settings(s, file);
+
+  const Settings r = load_settings(file);
+  EXPECT_EQ(r.source, file);
+  EXPECT_DOUBLE_EQ(r.camera.fx, s.camera.fx);
+  EXPECT_DOUBLE_EQ(r.camera.fy, s.camera.fy);
+  EXPECT_DOUBLE_EQ(r.camera.cx, s.camera.cx);
+  EXPECT_DOUBLE_EQ(r.camera.cy, s.camera.cy);
+  EXPECT_DOUBLE_EQ(r.camera.k1, s.camera.k1);
+  EXPECT_DOUBLE_EQ(r.camera.k2, s.camera.k2);
+  EXPECT_DOUBLE_EQ(r.camera.p1, s.camera.p1);
+  EXPECT_DOUBLE_EQ(r.camera.p2, s.camera.p2);
+  EXPECT_DOUBLE_EQ(r.camera.k3, s.camera.k3);
+  EXPECT_EQ(r.camera.width, 848);
+  EXPECT_EQ(r.camera.height, 480);
+  EXPECT_NEAR(r.camera.bf, s.camera.bf, 1e-9);
+  EXPECT_DOUBLE_EQ(r.fps, 15);
+  EXPECT_DOUBLE_EQ(r.depth_factor, 1000);
+  EXPECT_DOUBLE_EQ(r.th_depth, 35.5);
+  EXPECT_EQ(r.orb.n_features, 1500);
+  EXPECT_DOUBLE_EQ(r.orb.scale_factor, 1.25);
+  EXPECT_EQ(r.orb.n_levels, 6);
+  EXPECT_EQ(r.orb.ini_th_fast, 18);
+  EXPECT_EQ(r.orb.min_th_fast, 5);
+  EXPECT_EQ(setting_or<std::string>(r, "tracking.kernel", "l2"), "barron");
+  EXPECT_EQ(setting_or<int>(r, "tracking.iterations", 0), 7);
+  EXPECT_TRUE(setting_or<bool>(r, "tracking.robust", false));
+  EXPECT_DOUBLE_EQ(setting_or<double>(r, "mapping.window", 0.0), 12.5);
+}
+
+TEST(Settings, WritesBaselineInMetres) {
+  TempDir dir;
+  Settings s = default_settings();
+  s.camera.bf = s.camera.fx * 0.1;
+  save_settings(s, dir / "s.yaml");
+  const YAML::Node n = YAML::LoadFile((dir / "s.yaml").string());
+  EXPECT_NEAR(n["camera"]["baseline"].as<double>(), 0.1, 1e-15);
+  EXPECT_DOUBLE_EQ(n["depth"]["factor"].as<double>(), 5000);
+  EXPECT_EQ(n["orb"]["n_levels"].as<int>(), 8);
+}
+
+TEST(Settings, ReadsThe7ScenesOrbSlam3File) {
+  const std::filesystem::path file = std::filesystem::path(VARSLAM_SHARED_DIR) /
+                                     "realdata/7scenes_redkitchen/settings.yaml";
+  if (!std::filesystem::exists(file)) GTEST_SKIP() << "shared data not present: " << file;
+  const Settings s = load_settings(file);
+  EXPECT_DOUBLE_EQ(s.camera.fx, 585.0);
+  EXPECT_DOUBLE_EQ(s.camera.fy, 585.0);
+  EXPECT_DOUBLE_EQ(s.camera.cx, 320.0);
+  EXPECT_DOUBLE_EQ(s.camera.cy, 240.0);
+  EXPECT_EQ(s.camera.width, 640);
+  EXPECT_EQ(s.camera.height, 480);
+  EXPECT_DOUBLE_EQ(s.fps, 30.0);
+  EXPECT_NEAR(s.camera.bf, 585.0 * 0.07732, 1e-9);
+  EXPECT_DOUBLE_EQ(s.depth_factor, 1000.0);
+  EXPECT_DOUBLE_EQ(s.th_depth, 40.0);
+  EXPECT_EQ(s.orb.n_features, 1000);
+  EXPECT_DOUBLE_EQ(s.orb.scale_factor, 1.2);
+  EXPECT_EQ(s.orb.n_levels, 8);
+  EXPECT_EQ(s.orb.ini_th_fast, 20);
+  EXPECT_EQ(s.orb.min_th_fast, 7);
+  // Flat ORB-SLAM keys (one key with dots in its name) are reachable too.
+  EXPECT_DOUBLE_EQ(setting_or<double>(s, "Viewer.PointSize", 0.0), 2.0);
+  EXPECT_EQ(setting_or<std::string>(s, "Camera.type", ""), "PinHole");
+}
+
+TEST(Settings, ReadsTheOlderOrbSlamLayoutWithOpenCvHeaderAndMatrixTags) {
+  TempDir dir;
+  const auto file = dir.write("TUM1.yaml", R"(%YAML:1.0
+
+# older ORB-SLAM layout
+Camera.type: "PinHole"
+Camera.fx: 517.306408
+Camera.fy: 516.469215
+Camera.cx: 318.643040
+Camera.cy: 255.313989
+Camera.k1: 0.262383
+Camera.k2: -0.953104
+Camera.p1: -0.005358
+Camera.p2: 0.002628
+Camera.k3: 1.163314
+Camera.width: 640
+Camera.height: 480
+Camera.fps: 30.0
+Camera.bf: 40.0
+Camera.RGB: 1
+ThDepth: 40.0
+DepthMapFactor: 5000.0
+Tbc: !!opencv-matrix
+   rows: 4
+   cols: 4
+   dt: f
+   data: [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0]
+ORBextractor.nFeatures: 1200
+ORBextractor.scaleFactor: 1.2
+ORBextractor.nLevels: 8
+ORBextractor.iniThFAST: 20
+ORBextractor.minThFAST: 7
+Viewer.KeyFrameSize: 0.05
+)");
+  const Settings s = load_settings(file);
+  EXPECT_DOUBLE_EQ(s.camera.fx, 517.306408);
+  EXPECT_DOUBLE_EQ(s.camera.cy, 255.313989);
+  EXPECT_DOUBLE_EQ(s.camera.k1, 0.262383);
+  EXPECT_DOUBLE_EQ(s.camera.k3, 1.163314);
+  EXPECT_DOUBLE_EQ(s.camera.bf, 40.0);
+  EXPECT_DOUBLE_EQ(s.depth_factor, 5000.0);
+  EXPECT_DOUBLE_EQ(s.th_depth, 40.0);
+  EXPECT_EQ(s.orb.n_features, 1200);
+  EXPECT_EQ(setting_or<int>(s, "Tbc.rows", 0), 4);
+  EXPECT_TRUE(setting_or<bool>(s, "Camera.RGB", false));  // ORB-SLAM writes flags as 0/1
+}
+
+TEST(Settings, WrongTypeNamesFileLineAndKey) {
+  TempDir dir;
+  std::string text = kOurs;
+  text.replace(text.find("fy: 501.25"), 10, "fy: abc");
+  const auto file = dir.write("bad.yaml", text);
+  const std::string msg = config_error([&] { load_settings(file); });
+  EXPECT_THAT(msg, AllOf(HasSubstr(file.string() + ":3:"), HasSubstr("camera.fy"), HasSubstr("'abc'")));
+}
+
+TEST(Settings, OrbSlamKeyErrorsUseTheOrbSlamKeyName) {
+  TempDir dir;
+  const auto file = dir.write("orb.yaml", "%YAML:1.0\nCamera1.fx: 500\nCamera1.fy: -3\nCamera1.cx: 320\n"
+                                          "Camera1.cy: 240\nCamera.width: 640\nCamera.height: 480\n");
+  const std::string msg = config_error([&] { load_settings(file); });
+  EXPECT_THAT(msg, AllOf(HasSubstr(file.string() + ":3:"), HasSubstr("Camera1.fy"), HasSubstr("> 0")));
+}
+
+struct BadValue {
+  std::string from, to, key;
+};
+
+class SettingsBadValue : public ::testing::TestWithParam<BadValue> {};
+
+TEST_P(SettingsBadValue, IsAConfigErrorNamingFileAndKey) {
+  TempDir dir;
+  std::string text = kOurs;
+  const auto pos = text.find(GetParam().from);
+  ASSERT_NE(pos, std::string::npos) << GetParam().from;
+  text.replace(pos, GetParam().from.size(), GetParam().to);
+  const auto file = dir.write("bad.yaml", text);
+  const std::string msg = config_error([&] { load_settings(file); });
+  EXPECT_THAT(msg, AllOf(HasSubstr(file.string()), HasSubstr(GetParam().key)));
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    All, SettingsBadValue,
+    ::testing::Values(BadValue{"fx: 500.5", "fx: 0", "camera.fx"}, BadValue{"fy: 501.25", "fy: -1", "camera.fy"},
+                      BadValue{"width: 640", "width: 0", "camera.width"},
+                      BadValue{"height: 480", "height: 480.5", "camera.height"},
+                      BadValue{"fps: 30", "fps: 0", "camera.fps"},
+                      BadValue{"baseline: 0.08", "baseline: -0.08", "camera.baseline"},
+                      BadValue{"factor: 5000", "factor: 0", "depth.factor"},
+                      BadValue{"factor: 5000", "factor: [1, 2]", "depth.factor"},
+                      BadValue{"n_levels: 8", "n_levels: 0", "orb.n_levels"},
+                      BadValue{"scale_factor: 1.2", "scale_factor: 1.0", "orb.scale_factor"},
+                      BadValue{"n_features: 1000", "n_features: many", "orb.n_features"},
+                      BadValue{"fx: 500.5", "fx: .nan", "camera.fx"},
+                      BadValue{"  fx: 500.5\n", "", "camera.fx"}));  // missing required key
+
+TEST(Settings, MissingFileAndInvalidYamlAreConfigErrors) {
+  TempDir dir;
+  EXPECT_THAT(config_error([&] { load_settings(dir / "nope.yaml"); }), HasSubstr("nope.yaml"));
+  const auto file = dir.write("broken.yaml", "camera:\n  fx: [1, 2\n  fy: 3\n");
+  EXPECT_THAT(config_error([&] { load_settings(file); }), AllOf(HasSubstr("broken.yaml:"), HasSubstr("YAML")));
+  const auto list = dir.write("list.yaml", "- 1\n- 2\n");
+  EXPECT_THAT(config_error([&] { load_settings(list); }), HasSubstr("list.yaml"));
+}
+
+TEST(Settings, SettingOrFallsBackAndRejectsWrongTypes) {
+  TempDir dir;
+  std::string text = kOurs;
+  text += "tracking:\n  kernel: barron\n  iterations: 3.5\n  robust: maybe\n  empty:\n";
+  const auto file = dir.write("s.yaml", text);
+  const Settings s = load_settings(file);
+  EXPECT_EQ(setting_or<int>(s, "tracking.missing", 42), 42);
+  EXPECT_EQ(setting_or<int>(s, "nosection.key", 5), 5);
+  EXPECT_EQ(setting_or<int>(s, "tracking.kernel.deeper", 6), 6);
+  EXPECT_EQ(setting_or<double>(s, "tracking.empty", 1.5), 1.5);  // null counts as absent
+  EXPECT_DOUBLE_EQ(setting_or<double>(s, "tracking.iterations", 0.0), 3.5);
+  EXPECT_THAT(config_error([&] { setting_or<int>(s, "tracking.iterations", 0); }),
+              AllOf(HasSubstr(file.string()), HasSubstr("tracking.iterations"), HasSubstr("integer")));
+  EXPECT_THAT(config_error([&] { setting_or<bool>(s, "tracking.robust", false); }),
+              AllOf(HasSubstr(file.string()), HasSubstr("tracking.robust")));
+  EXPECT_THAT(config_error([&] { setting_or<std::string>(s, "tracking", ""); }), HasSubstr("tracking"));
+  // Defaults have no document: every key falls back.
+  EXPECT_EQ(setting_or<std::string>(default_settings(), "tracking.kernel", "l2"), "l2");
+}
+
+}  // namespace
+}  // namespace varslam

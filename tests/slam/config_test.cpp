@@ -1,0 +1,75 @@
+// Stage settings: kernels and their parameters come from the settings file, bad values are named errors.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "core/error.hpp"
+#include "slam/config.hpp"
+
+namespace varslam::slam {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path write_settings(const std::string& name, const std::string& body) {
+  const fs::path p = fs::temp_directory_path() / name;
+  std::ofstream(p) << "camera: {fx: 500, fy: 500, cx: 320, cy: 240, width: 640, height: 480, fps: 30, baseline: 0.08}\n"
+                   << "depth: {factor: 5000, th_depth: 40}\n"
+                   << body;
+  return p;
+}
+
+TEST(SlamConfig, DefaultsAreTheOrbSlam3Baseline) {
+  const SlamConfig c = slam_config_from(load_settings(write_settings("cfg_default.yaml", "")));
+  EXPECT_EQ(c.tracking.kernel.type, optim::KernelType::Huber);
+  EXPECT_EQ(c.mapping.kernel.type, optim::KernelType::Huber);
+  EXPECT_EQ(c.orb.n_features, 1000);
+}
+
+TEST(SlamConfig, ReadsKernelChoicesPerStage) {
+  const SlamConfig c = slam_config_from(load_settings(write_settings(
+      "cfg_kernels.yaml",
+      "tracking: {kernel: barron-fixed, barron_alpha: 0.5}\n"
+      "mapping: {kernel: barron-adaptive, tau: 20, alpha_fit: component, chi2_gates: false}\n")));
+  EXPECT_EQ(c.tracking.kernel.type, optim::KernelType::BarronFixed);
+  EXPECT_DOUBLE_EQ(c.tracking.kernel.barron_alpha, 0.5);
+  EXPECT_EQ(c.mapping.kernel.type, optim::KernelType::BarronAdaptive);
+  EXPECT_DOUBLE_EQ(c.mapping.kernel.tau, 20.0);
+  EXPECT_EQ(c.mapping.kernel.fit, robust::AlphaFit::PerComponent);
+  EXPECT_FALSE(c.mapping.kernel.chi2_gates);
+}
+
+TEST(SlamConfig, UnknownKernelNamesFileAndKey) {
+  const fs::path p = write_settings("cfg_bad_kernel.yaml", "mapping: {kernel: tukey}\n");
+  try {
+    slam_config_from(load_settings(p));
+    FAIL() << "expected ConfigError";
+  } catch (const ConfigError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("cfg_bad_kernel.yaml"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("mapping.kernel"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("tukey"), std::string::npos) << msg;
+  }
+}
+
+TEST(SlamConfig, RejectsNonPositiveTau) {
+  EXPECT_THROW(slam_config_from(load_settings(write_settings("cfg_tau.yaml", "mapping: {tau: -1}\n"))), ConfigError);
+}
+
+TEST(SlamConfig, ShippedCameraFilesLoad) {
+  const fs::path dir = fs::path(VARSLAM_SOURCE_DIR) / "config";
+  int n = 0;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    if (e.path().extension() != ".yaml") continue;
+    const Settings s = load_settings(e.path());
+    EXPECT_GT(s.camera.fx, 100.0) << e.path();
+    EXPECT_GT(s.camera.bf, 0.0) << e.path();
+    EXPECT_NO_THROW(slam_config_from(s)) << e.path();
+    ++n;
+  }
+  EXPECT_GE(n, 5);
+}
+
+}  // namespace
+}  // namespace varslam::slam

@@ -1,0 +1,124 @@
+// Map bookkeeping: observations, covisibility, culling and fusion keep the graph consistent.
+#include <gtest/gtest.h>
+
+#include "slam/keyframe.hpp"
+#include "slam/map.hpp"
+
+namespace varslam::slam {
+namespace {
+
+std::shared_ptr<const ScaleInfo> test_scale() {
+  auto s = std::make_shared<ScaleInfo>();
+  double f = 1.0;
+  for (int l = 0; l < 8; ++l, f *= 1.2) {
+    s->scale_factors.push_back(f);
+    s->level_sigma2.push_back(f * f);
+    s->inv_level_sigma2.push_back(1 / (f * f));
+  }
+  s->log_scale_factor = std::log(1.2);
+  return s;
+}
+
+Frame frame_with_points(long id, int n) {
+  std::vector<cv::KeyPoint> kps;
+  for (int i = 0; i < n; ++i) kps.emplace_back(cv::Point2f(10.0f + 5 * i, 100.0f), 31.0f, 0.0f, 0.0f, 0);
+  cv::Mat desc(n, 32, CV_8U, cv::Scalar(0));
+  for (int i = 0; i < n; ++i) desc.at<std::uint8_t>(i, 0) = static_cast<std::uint8_t>(i);
+  cv::Mat depth(480, 640, CV_32F, cv::Scalar(2.0f));
+  auto f = make_frame_features(kps, desc, depth, PinholeCamera{}, 3.0, test_scale());
+  return Frame(id, static_cast<double>(id), f);
+}
+
+struct SmallMap {
+  Map map;
+  std::vector<KeyFramePtr> kfs;
+  std::vector<MapPointPtr> points;
+};
+
+// Three keyframes that all observe the same 20 points.
+void build(SmallMap& m, int n_points = 20) {
+  for (int k = 0; k < 3; ++k) m.kfs.push_back(std::make_shared<KeyFrame>(m.map.next_keyframe_id(), frame_with_points(k, n_points)));
+  for (int i = 0; i < n_points; ++i) {
+    auto mp = std::make_shared<MapPoint>(m.map.next_map_point_id(), Eigen::Vector3d(i * 0.1, 0, 2), m.kfs[0]);
+    for (auto& kf : m.kfs) {
+      mp->add_observation(kf, i, true);
+      kf->add_map_point(mp, i);
+    }
+    m.points.push_back(mp);
+    m.map.add_map_point(mp);
+  }
+  for (auto& kf : m.kfs) {
+    m.map.add_keyframe(kf);
+  }
+  for (auto& kf : m.kfs) kf->update_connections();
+}
+
+TEST(Map, CovisibilityWeightsCountSharedPoints) {
+  SmallMap m;
+  build(m);
+  EXPECT_EQ(m.kfs[1]->weight(m.kfs[0]), 20);
+  EXPECT_EQ(m.kfs[0]->weight(m.kfs[2]), 20);
+  EXPECT_EQ(m.kfs[2]->covisibles().size(), 2u);
+  EXPECT_EQ(m.kfs[1]->parent(), m.kfs[0]);  // first connection chooses the heaviest, lowest id
+  m.map.clear();
+}
+
+TEST(Map, ErasingObservationsMakesPointBadAtTwoOrFewer) {
+  SmallMap m;
+  build(m);
+  const MapPointPtr mp = m.points[3];
+  EXPECT_EQ(mp->num_observations(), 6);  // depth observations count twice
+  mp->erase_observation(m.kfs[2]);
+  EXPECT_FALSE(mp->is_bad());
+  mp->erase_observation(m.kfs[1]);
+  EXPECT_TRUE(mp->is_bad());
+  EXPECT_EQ(m.kfs[0]->map_point(3), nullptr);  // a bad point detaches from every keyframe
+  m.map.clear();
+}
+
+TEST(Map, CulledKeyframeDetachesAndReparentsChildren) {
+  SmallMap m;
+  build(m);
+  m.kfs[2]->change_parent(m.kfs[1]);
+  const Eigen::Isometry3d before = m.kfs[2]->pose();
+  m.kfs[1]->set_bad();
+  EXPECT_TRUE(m.kfs[1]->is_bad());
+  EXPECT_EQ(m.kfs[2]->parent(), m.kfs[0]);
+  EXPECT_EQ(m.kfs[0]->weight(m.kfs[1]), 0);
+  EXPECT_EQ(m.points[0]->index_in(m.kfs[1].get()), -1);
+  // A culled keyframe follows its parent: moving the parent moves its resolved pose.
+  Eigen::Isometry3d moved = m.kfs[0]->pose();
+  moved.translation() += Eigen::Vector3d(1, 0, 0);
+  m.kfs[0]->set_pose(moved);
+  EXPECT_NEAR((m.kfs[1]->resolved_pose().translation() - before.translation()).norm(), 1.0, 1e-9);
+  m.map.clear();
+}
+
+TEST(Map, ReplaceMovesObservationsToSurvivor) {
+  SmallMap m;
+  build(m);
+  auto dup = std::make_shared<MapPoint>(m.map.next_map_point_id(), Eigen::Vector3d(5, 5, 5), m.kfs[0]);
+  // dup is observed only in a keypoint that no other point uses in kf 0 (reuse index 0 after freeing it).
+  m.points[0]->erase_observation(m.kfs[0]);
+  m.kfs[0]->erase_map_point(0);
+  dup->add_observation(m.kfs[0], 0, true);
+  m.kfs[0]->add_map_point(dup, 0);
+  dup->replace_with(m.points[0]);
+  EXPECT_TRUE(dup->is_bad());
+  EXPECT_EQ(dup->replaced_by(), m.points[0]);
+  EXPECT_EQ(m.kfs[0]->map_point(0), m.points[0]);
+  EXPECT_EQ(m.points[0]->index_in(m.kfs[0].get()), 0);
+  m.map.clear();
+}
+
+TEST(Frame, GridSearchFindsKeypointsInRadiusAndLevel) {
+  const Frame f = frame_with_points(0, 20);
+  const auto hits = f.features->in_area(30.0, 100.0, 6.0);
+  // Keypoints at x = 25, 30, 35 lie within 6 px of (30, 100).
+  EXPECT_EQ(hits.size(), 3u);
+  EXPECT_TRUE(f.features->in_area(30.0, 100.0, 6.0, 1, 2).empty());
+  EXPECT_NEAR(f.features->u_right[0], 10.0 - 40.0 / 2.0, 1e-5);
+}
+
+}  // namespace
+}  // namespace varslam::slam

@@ -1,0 +1,373 @@
+// Generator tests: output layout and parsing, determinism, sensor statistics, boxes, poses, config errors.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "io/boxes_io.hpp"
+#include "io/settings.hpp"
+#include "io/trajectory_io.hpp"
+#include "synth/camera_path.hpp"
+#include "synth/movers.hpp"
+#include "synth/renderer.hpp"
+#include "synth/sensor.hpp"
+#include "synth/synth.hpp"
+
+namespace fs = std::filesystem;
+using namespace varslam;
+using namespace varslam::synth;
+
+namespace {
+
+fs::path temp_dir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("varslam_synth_test_" + name);
+  fs::remove_all(d);
+  return d;
+}
+
+SynthConfig short_config(const std::string& scenario, double seconds = 1.0, double fps = 10.0) {
+  SynthConfig cfg;
+  cfg.scenario = scenario;
+  cfg.seconds = seconds;
+  cfg.fps = fps;
+  return cfg;
+}
+
+std::vector<std::pair<double, std::string>> read_list(const fs::path& file) {
+  std::ifstream in(file);
+  std::vector<std::pair<double, std::string>> out;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream ss(line);
+    double t;
+    std::string name;
+    ss >> t >> name;
+    out.emplace_back(t, name);
+  }
+  return out;
+}
+
+std::string slurp(const fs::path& f) {
+  std::ifstream in(f, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), {}};
+}
+
+}  // namespace
+
+TEST(Synth, ScenarioNamesAreTheDocumentedSix) {
+  EXPECT_EQ(scenario_names(),
+            (std::vector<std::string>{"static", "walking", "unknown_box", "obstructing_box", "balloon", "mixed"}));
+}
+
+TEST(Synth, EveryScenarioWritesAParsableTumFolder) {
+  for (const auto& name : scenario_names()) {
+    SCOPED_TRACE(name);
+    const fs::path dir = temp_dir("layout_" + name);
+    const SynthSummary s = generate(short_config(name), dir);
+    ASSERT_EQ(s.frames, 10u);
+    for (const char* f : {"rgb.txt", "depth.txt", "groundtruth.txt", "boxes.txt", "settings.yaml", "scenario.json",
+                          "preview.png"})
+      EXPECT_TRUE(fs::exists(dir / f)) << f;
+    const auto rgb = read_list(dir / "rgb.txt"), depth = read_list(dir / "depth.txt");
+    ASSERT_EQ(rgb.size(), 10u);
+    ASSERT_EQ(depth.size(), 10u);
+    for (std::size_t i = 0; i < rgb.size(); ++i) {
+      EXPECT_NEAR(rgb[i].first - rgb[0].first, i / 10.0, 1e-6);
+      EXPECT_EQ(rgb[i].first, depth[i].first);
+    }
+    const cv::Mat c = cv::imread((dir / rgb[3].second).string(), cv::IMREAD_UNCHANGED);
+    const cv::Mat d = cv::imread((dir / depth[3].second).string(), cv::IMREAD_UNCHANGED);
+    ASSERT_EQ(c.type(), CV_8UC3);
+    ASSERT_EQ(d.type(), CV_16UC1);
+    EXPECT_EQ(c.size(), cv::Size(640, 480));
+    EXPECT_EQ(d.size(), cv::Size(640, 480));
+    EXPECT_GT(cv::countNonZero(d), 640 * 480 / 2);  // most pixels have depth
+    cv::Scalar mean, stddev;
+    cv::meanStdDev(c, mean, stddev);
+    EXPECT_GT(stddev[0], 10.0);  // a textured room, not a flat image
+
+    const Trajectory gt = read_tum_trajectory(dir / "groundtruth.txt");
+    ASSERT_EQ(gt.size(), 10u);
+    EXPECT_NEAR(gt[0].timestamp, rgb[0].first, 1e-6);
+    EXPECT_LT(gt[0].T_wc.translation().norm(), 1e-6);  // path re-expressed relative to its first pose
+    EXPECT_NO_THROW(read_boxes_file(dir / "boxes.txt"));
+    const Settings st = load_settings(dir / "settings.yaml");
+    EXPECT_DOUBLE_EQ(st.camera.fx, 525.0);
+    EXPECT_DOUBLE_EQ(st.camera.cy, 239.5);
+    EXPECT_DOUBLE_EQ(st.depth_factor, 5000.0);
+    EXPECT_NEAR(st.camera.bf, 40.0, 1e-9);
+    const auto j = nlohmann::json::parse(slurp(dir / "scenario.json"));
+    EXPECT_EQ(j.at("scenario"), name);
+    EXPECT_EQ(j.at("frames"), 10);
+    fs::remove_all(dir);
+  }
+}
+
+TEST(Synth, SameSeedGivesIdenticalBytesOtherSeedDiffers) {
+  auto cfg = short_config("mixed", 0.3);
+  cfg.seed = 7;
+  const fs::path a = temp_dir("det_a"), b = temp_dir("det_b"), c = temp_dir("det_c");
+  generate(cfg, a);
+  generate(cfg, b);
+  cfg.seed = 8;
+  generate(cfg, c);
+  std::size_t compared = 0;
+  for (const auto& e : fs::recursive_directory_iterator(a)) {
+    if (!e.is_regular_file()) continue;
+    const fs::path rel = fs::relative(e.path(), a);
+    EXPECT_EQ(slurp(e.path()), slurp(b / rel)) << rel;
+    ++compared;
+  }
+  EXPECT_EQ(compared, 3u * 2u + 7u);
+  const auto list = read_list(a / "rgb.txt");
+  EXPECT_NE(slurp(a / list[1].second), slurp(c / list[1].second));
+  for (const auto& d : {a, b, c}) fs::remove_all(d);
+}
+
+TEST(SynthSensor, DepthNoiseMatchesTheKinectModel) {
+  SplitMix64 rng(3);
+  const GaussianTable gauss(5);
+  DepthSensorParams p;
+  p.edge_holes = false;
+  p.random_holes = 0;
+  for (const double z : {1.0, 2.0, 4.0}) {
+    const cv::Mat1f plane(480, 640, static_cast<float>(z));
+    const cv::Mat1w raw = sense_depth(plane, p, rng, gauss);
+    cv::Mat1d metres;
+    raw.convertTo(metres, CV_64F, 1.0 / 5000.0);
+    cv::Scalar mean, sd;
+    cv::meanStdDev(metres, mean, sd);
+    const double sigma = 0.0012 + 0.0019 * (z - 0.4) * (z - 0.4);
+    EXPECT_DOUBLE_EQ(kinect_depth_sigma(z), sigma);
+    EXPECT_NEAR(mean[0], z, 3 * sigma / std::sqrt(640.0 * 480.0) + 1e-4) << z;
+    // Quantisation (0.2 mm steps) adds 0.2^2/12 mm^2 of variance: negligible at these sigmas.
+    EXPECT_NEAR(sd[0], sigma, 0.03 * sigma) << z;
+  }
+}
+
+TEST(SynthSensor, DepthDropsBeyondRangeAndAtDiscontinuities) {
+  SplitMix64 rng(3);
+  const GaussianTable gauss(5);
+  DepthSensorParams p;
+  p.random_holes = 0;
+  cv::Mat1f step(100, 100, 1.5f);
+  step.colRange(50, 100).setTo(3.0f);
+  step.rowRange(0, 10).setTo(6.0f);  // beyond the 5.5 m range
+  const cv::Mat1w raw = sense_depth(step, p, rng, gauss);
+  EXPECT_EQ(cv::countNonZero(raw.rowRange(0, 10)), 0);
+  // The far side of the edge (column 50) is lost in most rows, pixels away from the edge are kept.
+  EXPECT_LT(cv::countNonZero(raw(cv::Rect(50, 12, 1, 88))), 30);
+  EXPECT_EQ(cv::countNonZero(raw(cv::Rect(10, 12, 30, 88))), 30 * 88);
+  p.edge_holes = false;
+  p.noise = false;
+  const cv::Mat1w clean = sense_depth(step, p, rng, gauss);
+  EXPECT_EQ(clean(50, 20), 7500);  // 1.5 m at factor 5000, exact without noise
+  EXPECT_EQ(clean(50, 70), 15000);
+}
+
+TEST(Synth, PeopleBoxesAreInsideTheImageAndPresentWhenPeopleAreVisible) {
+  const fs::path dir = temp_dir("boxes");
+  const SynthSummary s = generate(short_config("walking", 2.0, 5.0), dir);
+  EXPECT_GE(s.people, 2u);
+  EXPECT_GT(s.frames_with_person, 0u);
+  const BoxesByTime boxes = read_boxes_file(dir / "boxes.txt");
+  EXPECT_EQ(boxes.size(), s.frames_with_person);  // no misses configured: a box whenever someone is in view
+  std::size_t n = 0;
+  for (const auto& [t, dets] : boxes)
+    for (const auto& d : dets) {
+      EXPECT_EQ(d.label, "person");
+      EXPECT_GE(d.box.x, 0.0f);
+      EXPECT_GE(d.box.y, 0.0f);
+      EXPECT_GT(d.box.width, 0.0f);
+      EXPECT_GT(d.box.height, 0.0f);
+      EXPECT_LE(d.box.x + d.box.width, 640.0f);
+      EXPECT_LE(d.box.y + d.box.height, 480.0f);
+      ++n;
+    }
+  EXPECT_EQ(n, s.person_boxes);
+
+  // The box must cover the person: pixels inside are mostly nearer than the room behind.
+  const auto depth_list = read_list(dir / "depth.txt");
+  const auto& [t0, dets0] = *boxes.begin();
+  std::string depth_file;
+  for (const auto& [t, f] : depth_list)
+    if (std::abs(t - t0) < 1e-6) depth_file = f;
+  ASSERT_FALSE(depth_file.empty());
+  const cv::Mat1w depth = cv::imread((dir / depth_file).string(), cv::IMREAD_UNCHANGED);
+  EXPECT_GT(cv::countNonZero(depth(cv::Rect(dets0[0].box))), 0);
+
+  // Misses drop boxes, jitter moves them but keeps them in the image.
+  auto cfg = short_config("walking", 2.0, 5.0);
+  cfg.box_miss_rate = 1.0;
+  generate(cfg, dir);
+  EXPECT_TRUE(read_boxes_file(dir / "boxes.txt").empty());
+  cfg.box_miss_rate = 0.0;
+  cfg.box_jitter_px = 4.0;
+  generate(cfg, dir);
+  const BoxesByTime jittered = read_boxes_file(dir / "boxes.txt");
+  ASSERT_EQ(jittered.size(), boxes.size());
+  double moved = 0;
+  for (const auto& [t, dets] : jittered) {
+    const auto& ref = boxes.at(t);
+    ASSERT_EQ(dets.size(), ref.size());
+    for (std::size_t i = 0; i < dets.size(); ++i) {
+      moved += std::abs(dets[i].box.x - ref[i].box.x);
+      EXPECT_GE(dets[i].box.x, 0.0f);
+      EXPECT_LE(dets[i].box.x + dets[i].box.width, 640.0f);
+    }
+  }
+  EXPECT_GT(moved / static_cast<double>(s.person_boxes), 1.0);
+  fs::remove_all(dir);
+}
+
+TEST(Synth, StaticSceneHasNoBoxes) {
+  const fs::path dir = temp_dir("static");
+  const SynthSummary s = generate(short_config("static", 0.5), dir);
+  EXPECT_EQ(s.person_boxes, 0u);
+  EXPECT_EQ(s.people, 0u);
+  EXPECT_EQ(s.unknown_movers, 0u);
+  EXPECT_TRUE(read_boxes_file(dir / "boxes.txt").empty());
+  fs::remove_all(dir);
+}
+
+TEST(Synth, GroundTruthEqualsTheInterpolatedPathRelativeToItsStart) {
+  const fs::path path_dir = fs::path(VARSLAM_SHARED_DIR) / "trajectories" / "rgbd_dataset_freiburg1_desk";
+  if (!fs::exists(path_dir / "groundtruth.txt")) GTEST_SKIP() << "no shared trajectories";
+  auto cfg = short_config("static", 0.5, 30.0);
+  cfg.path_file = path_dir;  // a folder holding groundtruth.txt
+  cfg.path_start = 3.0;
+  cfg.preview = false;
+  const fs::path dir = temp_dir("gt");
+  generate(cfg, dir);
+  const Trajectory path = read_tum_trajectory(path_dir / "groundtruth.txt");
+  const Trajectory gt = read_tum_trajectory(dir / "groundtruth.txt");
+  ASSERT_EQ(gt.size(), 15u);
+  const double t0 = path.front().timestamp + 3.0;
+  EXPECT_NEAR(gt[0].timestamp, t0, 1e-6);
+  const Eigen::Isometry3d T0_inv = interpolate_pose(path, t0).inverse();
+  for (const auto& p : gt) {
+    const Eigen::Isometry3d expect = T0_inv * interpolate_pose(path, p.timestamp);
+    EXPECT_LT((p.T_wc.translation() - expect.translation()).norm(), 1e-5);
+    EXPECT_LT(Eigen::AngleAxisd(p.T_wc.rotation().transpose() * expect.rotation()).angle(), 1e-5);
+  }
+  fs::remove_all(dir);
+}
+
+TEST(SynthPath, InterpolationIsLerpPlusSlerp) {
+  Trajectory path(2);
+  path[0].timestamp = 10.0;
+  path[1].timestamp = 11.0;
+  path[1].T_wc.translation() = Eigen::Vector3d(1, 2, 3);
+  path[1].T_wc.linear() = Eigen::AngleAxisd(0.8, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  const Eigen::Isometry3d m = interpolate_pose(path, 10.25);
+  EXPECT_LT((m.translation() - Eigen::Vector3d(0.25, 0.5, 0.75)).norm(), 1e-12);
+  const Eigen::AngleAxisd aa(m.rotation());
+  EXPECT_NEAR(aa.angle(), 0.2, 1e-9);
+  EXPECT_NEAR(std::abs(aa.axis().y()), 1.0, 1e-9);
+  EXPECT_TRUE(interpolate_pose(path, 12.0).isApprox(path[1].T_wc));  // clamped at the ends
+}
+
+TEST(SynthPath, BuiltInPathIsARealTwentySecondExcerpt) {
+  const Trajectory p = builtin_camera_path();
+  ASSERT_GT(p.size(), 550u);
+  EXPECT_GT(p.back().timestamp - p.front().timestamp, 20.0);
+  double travelled = 0;
+  for (std::size_t i = 1; i < p.size(); ++i) {
+    EXPECT_GT(p[i].timestamp, p[i - 1].timestamp);
+    travelled += (p[i].T_wc.translation() - p[i - 1].T_wc.translation()).norm();
+  }
+  EXPECT_GT(travelled, 1.0);  // hand-held motion, not a still camera
+}
+
+TEST(Synth, BadConfigurationThrowsInputError) {
+  const fs::path dir = temp_dir("bad");
+  auto expect_error = [&](SynthConfig cfg, const std::string& fragment) {
+    try {
+      generate(cfg, dir);
+      ADD_FAILURE() << "no error for " << fragment;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+    }
+  };
+  expect_error(short_config("dancing"), "unknown scenario 'dancing'");
+  expect_error(short_config("walking", 25.0, 30.0), "20.57 s long");  // built-in path is shorter
+  expect_error(short_config("walking", 1.0, 0.0), "fps");
+  expect_error(short_config("walking", 1.0, std::nan("")), "fps");
+  expect_error(short_config("walking", -1.0), "seconds");
+  auto miss = short_config("walking");
+  miss.box_miss_rate = 1.5;
+  expect_error(miss, "miss rate");
+  auto late = short_config("walking", 5.0);
+  late.path_start = 18.0;
+  expect_error(late, "starting at 18.00 s");
+  auto nofile = short_config("walking");
+  nofile.path_file = dir / "missing.txt";
+  expect_error(nofile, "missing.txt");
+  fs::remove_all(dir);
+}
+
+TEST(SynthMovers, ObstructingBoxFillsALargePartOfTheImage) {
+  const auto still = [](double) { return Eigen::Isometry3d(Eigen::Isometry3d::Identity()); };
+  ViewAnchor anchor;
+  const Movers movers = Movers::script("obstructing_box", anchor, 1.35, 10.0, still, 3);
+  ASSERT_EQ(movers.objects().size(), 1u);
+  const auto& ep = movers.objects()[0].episodes.at(0);
+  Scene scene = build_static_scene({-4, -1.4, -2}, {4, 1.35, 6}, anchor, {}, 1);
+  Movers m = movers;
+  m.add_materials(scene, 2);
+  const Renderer renderer{PinholeCamera{}};
+  RenderOutput out;
+  double max_share = 0;
+  for (double u : {0.4, 0.5, 0.6}) {
+    std::vector<Primitive> dyn;
+    m.primitives_at(ep.start + u * ep.length, dyn);
+    renderer.render(scene, dyn, Eigen::Isometry3d::Identity(), out);
+    const double share = cv::countNonZero(out.ids >= kFirstObjectId) / (640.0 * 480.0);
+    EXPECT_GT(share, 0.3) << u;
+    EXPECT_LT(share, 0.75) << u;
+    max_share = std::max(max_share, share);
+  }
+  // Out of view before the episode.
+  std::vector<Primitive> dyn;
+  m.primitives_at(ep.start + 0.01, dyn);
+  renderer.render(scene, dyn, Eigen::Isometry3d::Identity(), out);
+  EXPECT_EQ(cv::countNonZero(out.ids >= kFirstObjectId), 0);
+}
+
+TEST(SynthMovers, PeopleAreHumanSizedAndWalkAtHumanSpeed) {
+  const auto still = [](double) { return Eigen::Isometry3d(Eigen::Isometry3d::Identity()); };
+  const Movers m = Movers::script("walking", ViewAnchor{}, 1.35, 10.0, still, 9);
+  ASSERT_GE(m.people().size(), 2u);
+  for (const auto& p : m.people()) {
+    EXPECT_GE(p.height, 1.6);
+    EXPECT_LE(p.height, 1.9);
+    std::vector<Primitive> parts;
+    person_primitives(p, 0.7, 1.35, parts);
+    double top = 1e9;
+    for (const auto& q : parts) {
+      Eigen::Vector3d lo, hi;
+      q.bounds(lo, hi);
+      top = std::min(top, lo.y());
+      EXPECT_EQ(q.object_id, p.id);
+    }
+    EXPECT_NEAR(1.35 - top, p.height, 0.06);  // head top at the person's height above the floor
+    std::vector<double> speeds;
+    for (int k = 0; k < 21; ++k) {
+      Eigen::Vector2d a, b, h;
+      double phase;
+      p.state_at(0.5 * k, a, h, phase);
+      p.state_at(0.5 * k + 0.1, b, h, phase);
+      speeds.push_back((b - a).norm() / 0.1);
+    }
+    std::nth_element(speeds.begin(), speeds.begin() + 10, speeds.end());  // median: turns are rare
+    EXPECT_GE(speeds[10], 0.8);
+    EXPECT_LE(speeds[10], 1.5 + 1e-9);
+  }
+}
