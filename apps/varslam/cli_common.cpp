@@ -2,7 +2,10 @@
 
 #include <fmt/format.h>
 
+#include <spdlog/spdlog.h>
+
 #include "core/error.hpp"
+#include "report/run_report.hpp"
 
 namespace varslam::cli {
 
@@ -18,6 +21,14 @@ void apply_overrides(Settings& settings, const std::vector<std::string>& overrid
     if (sec && !sec.IsMap())
       throw ConfigError(fmt::format("--set '{}': settings key '{}' is not a section", o, section));
     settings.root[section][key] = YAML::Load(value);
+  }
+}
+
+void write_report_for_run(const std::filesystem::path& run_dir, const std::filesystem::path& sequence_dir) {
+  try {
+    report::write_run_report(run_dir, sequence_dir, run_dir / "report.html");
+  } catch (const std::exception& e) {
+    spdlog::warn("report not written: {}", e.what());
   }
 }
 
@@ -41,6 +52,8 @@ void print_run_summary(const slam::RunSummary& s) {
   fmt::print("trajectory       {}\n", (s.out_dir / "CameraTrajectory.txt").string());
   fmt::print("metrics          {}\n", (s.out_dir / "metrics.json").string());
   fmt::print("map              {}\n", (s.out_dir / "map.ply").string());
+  if (std::filesystem::exists(s.out_dir / "report.html"))
+    fmt::print("report           {}\n", (s.out_dir / "report.html").string());
 }
 
 }  // namespace varslam::cli

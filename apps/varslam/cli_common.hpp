@@ -12,6 +12,9 @@ namespace varslam::cli {
 /// semantic, features, ...). Throws ConfigError on a malformed override.
 void apply_overrides(Settings& settings, const std::vector<std::string>& overrides);
 
+/// Writes <run>/report.html (plots of the trajectory, error, alpha per keyframe, timings); a failure is a warning.
+void write_report_for_run(const std::filesystem::path& run_dir, const std::filesystem::path& sequence_dir);
+
 /// One human-readable block: frames, tracking share, keyframes, speed, ATE, and where the files went.
 void print_run_summary(const slam::RunSummary& s);
 

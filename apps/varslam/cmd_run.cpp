@@ -41,6 +41,7 @@ void add_run_command(CLI::App& app) {
     ro.progress = !o->quiet;
     if (!o->groundtruth.empty()) ro.groundtruth = o->groundtruth;
     const slam::RunSummary s = slam::run_slam(*dataset, settings, cfg, ro, o->out);
+    write_report_for_run(s.out_dir, o->dataset);
     print_run_summary(s);
   });
 }

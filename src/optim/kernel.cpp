@@ -7,34 +7,14 @@
 
 namespace varslam::optim {
 
+Kernel::Kernel(const KernelConfig& cfg, double alpha)
+    : type_(cfg.type),
+      delta_mono_(std::sqrt(kChi2Mono)),
+      delta_stereo_(std::sqrt(kChi2Stereo)),
+      barron_(alpha, cfg.barron_c) {}
+
 void evaluate_kernel(const KernelConfig& cfg, double alpha, int dof, double s, double out[3]) {
-  switch (cfg.type) {
-    case KernelType::None:
-      out[0] = s;
-      out[1] = 1.0;
-      out[2] = 0.0;
-      return;
-    case KernelType::Huber: {
-      // Huber on the whitened norm with delta^2 = the chi2 gate (ORB-SLAM3's choice).
-      const double delta2 = chi2_threshold(dof);
-      if (s <= delta2) {
-        out[0] = s;
-        out[1] = 1.0;
-        out[2] = 0.0;
-      } else {
-        const double r = std::sqrt(s);
-        const double delta = std::sqrt(delta2);
-        out[0] = 2.0 * delta * r - delta2;
-        out[1] = delta / r;
-        out[2] = -0.5 * out[1] / s;
-      }
-      return;
-    }
-    case KernelType::BarronFixed:
-    case KernelType::BarronAdaptive:
-      robust::barron_kernel(s, alpha, cfg.barron_c, out);
-      return;
-  }
+  Kernel(cfg, alpha).evaluate(dof, s, out);
 }
 
 KernelLoss* make_loss(const KernelConfig& cfg, int dof, double alpha) {

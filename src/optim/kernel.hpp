@@ -1,6 +1,7 @@
 #pragma once
 // Robust kernels shared by every optimiser in this module (Ceres losses and the dedicated IRLS solver
 // evaluate the very same function), plus ORB-SLAM's chi-square outlier gates and the adaptive-alpha fit.
+#include <cmath>
 #include <span>
 #include <vector>
 
@@ -26,23 +27,71 @@ inline constexpr double kChi2Mono = 5.991;    // 2 dof
 inline constexpr double kChi2Stereo = 7.815;  // 3 dof
 inline double chi2_threshold(int dof) { return dof == 3 ? kChi2Stereo : kChi2Mono; }
 
-/// Kernel on a squared whitened error s, in Ceres' convention: out = {rho(s), rho'(s), rho''(s)}.
-/// `dof` (2 or 3) picks the Huber delta; `alpha` is used by both Barron types (fixed or current estimate).
+/// The configured kernel at one alpha with its constants precomputed (Huber deltas, Barron's shape): build it
+/// once per solve or alpha change, evaluate it per residual. `alpha` is used by both Barron types (fixed or
+/// current estimate) and ignored otherwise.
+class Kernel {
+ public:
+  Kernel(const KernelConfig& cfg, double alpha);
+  KernelType type() const { return type_; }
+  double alpha() const { return barron_.alpha(); }
+
+  /// Kernel on a squared whitened error s, in Ceres' convention: out = {rho(s), rho'(s), rho''(s)}.
+  /// `dof` (2 or 3) picks the Huber delta.
+  void evaluate(int dof, double s, double out[3]) const {
+    switch (type_) {
+      case KernelType::None:
+        out[0] = s;
+        out[1] = 1.0;
+        out[2] = 0.0;
+        return;
+      case KernelType::Huber: {
+        // Huber on the whitened norm with delta^2 = the chi2 gate (ORB-SLAM3's choice).
+        const double delta2 = chi2_threshold(dof);
+        if (s <= delta2) {
+          out[0] = s;
+          out[1] = 1.0;
+          out[2] = 0.0;
+        } else {
+          const double r = std::sqrt(s);
+          const double delta = dof == 3 ? delta_stereo_ : delta_mono_;
+          out[0] = 2.0 * delta * r - delta2;
+          out[1] = delta / r;
+          out[2] = -0.5 * out[1] / s;
+        }
+        return;
+      }
+      case KernelType::BarronFixed:
+      case KernelType::BarronAdaptive:
+        barron_.evaluate(s, out);
+        return;
+    }
+  }
+
+ private:
+  KernelType type_;
+  double delta_mono_, delta_stereo_;
+  robust::BarronKernel barron_;
+};
+
+/// One-off kernel evaluation (builds a Kernel per call; loops should hold a Kernel instead).
 void evaluate_kernel(const KernelConfig& cfg, double alpha, int dof, double s, double out[3]);
 
-/// ceres::LossFunction calling evaluate_kernel. The alpha can change between solves (adaptive alternation);
+/// ceres::LossFunction evaluating a Kernel. The alpha can change between solves (adaptive alternation);
 /// it must not change while a solve is running.
 class KernelLoss final : public ceres::LossFunction {
  public:
-  KernelLoss(const KernelConfig& cfg, int dof, double alpha) : cfg_(cfg), dof_(dof), alpha_(alpha) {}
-  void Evaluate(double s, double out[3]) const override { evaluate_kernel(cfg_, alpha_, dof_, s, out); }
-  void set_alpha(double alpha) { alpha_ = alpha; }
-  double alpha() const { return alpha_; }
+  KernelLoss(const KernelConfig& cfg, int dof, double alpha) : cfg_(cfg), dof_(dof), kernel_(cfg, alpha) {}
+  void Evaluate(double s, double out[3]) const override { kernel_.evaluate(dof_, s, out); }
+  void set_alpha(double alpha) {
+    if (alpha != kernel_.alpha()) kernel_ = Kernel(cfg_, alpha);
+  }
+  double alpha() const { return kernel_.alpha(); }
 
  private:
   KernelConfig cfg_;
   int dof_;
-  double alpha_;
+  Kernel kernel_;
 };
 
 /// Loss for the configured kernel, or nullptr for KernelType::None (plain least squares). Caller owns it.

@@ -53,32 +53,57 @@ class BaState {
     return whitened_residual(cam_, o.obs, p_c, e, nullptr);
   }
 
-  /// Builds a Ceres problem over the active observations; parameters not touched by them stay out.
-  std::unique_ptr<ceres::Problem> build(const std::vector<bool>& active, ceres::ParameterBlockOrdering* ordering) {
+  /// Builds the Ceres problem over the active observations once; later phases only remove observations
+  /// (deactivate), so the problem, the residual blocks and the elimination ordering are never rebuilt.
+  void build(const std::vector<bool>& active) {
     ceres::Problem::Options po;
     po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-    po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;  // the KernelLoss objects outlive every solve
     po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-    auto problem = std::make_unique<ceres::Problem>(po);
+    po.enable_fast_removal = true;
+    ceres_ = std::make_unique<ceres::Problem>(po);
+    ordering_ = std::make_shared<ceres::ParameterBlockOrdering>();
+    blocks_.assign(costs_.size(), nullptr);
+    pose_uses_.assign(problem_.keyframes.size(), 0);
+    point_uses_.assign(problem_.points.size(), 0);
     for (std::size_t j = 0; j < costs_.size(); ++j) {
       if (!active[j]) continue;
       const BaObservation& o = problem_.observations[j];
       double* x_pose = pose(o.keyframe);
       double* x_point = point(o.point);
-      if (!problem->HasParameterBlock(x_pose)) {
-        problem->AddParameterBlock(x_pose, kPoseParams, &manifold_);
-        if (problem_.keyframes[o.keyframe].fixed) problem->SetParameterBlockConstant(x_pose);
-        ordering->AddElementToGroup(x_pose, 1);
+      if (pose_uses_[o.keyframe]++ == 0) {
+        ceres_->AddParameterBlock(x_pose, kPoseParams, &manifold_);
+        if (problem_.keyframes[o.keyframe].fixed) ceres_->SetParameterBlockConstant(x_pose);
+        ordering_->AddElementToGroup(x_pose, 1);
       }
-      if (!problem->HasParameterBlock(x_point)) {
-        problem->AddParameterBlock(x_point, 3);
-        ordering->AddElementToGroup(x_point, 0);  // eliminated first by the Schur complement
+      if (point_uses_[o.point]++ == 0) {
+        ceres_->AddParameterBlock(x_point, 3);
+        ordering_->AddElementToGroup(x_point, 0);  // eliminated first by the Schur complement
       }
-      problem->AddResidualBlock(costs_[j].get(), o.obs.stereo() ? stereo_loss_.get() : mono_loss_.get(), x_pose,
-                                x_point);
+      blocks_[j] = ceres_->AddResidualBlock(costs_[j].get(), o.obs.stereo() ? stereo_loss_.get() : mono_loss_.get(),
+                                            x_pose, x_point);
     }
-    return problem;
   }
+
+  /// Removes observation j from the problem; parameter blocks left without observations leave it too
+  /// (and the ordering, which must name exactly the problem's blocks).
+  void deactivate(std::size_t j) {
+    if (!blocks_[j]) return;
+    ceres_->RemoveResidualBlock(blocks_[j]);
+    blocks_[j] = nullptr;
+    const BaObservation& o = problem_.observations[j];
+    if (--pose_uses_[o.keyframe] == 0) {
+      ceres_->RemoveParameterBlock(pose(o.keyframe));
+      ordering_->Remove(pose(o.keyframe));
+    }
+    if (--point_uses_[o.point] == 0) {
+      ceres_->RemoveParameterBlock(point(o.point));
+      ordering_->Remove(point(o.point));
+    }
+  }
+
+  ceres::Problem& ceres_problem() { return *ceres_; }
+  const std::shared_ptr<ceres::ParameterBlockOrdering>& ordering() const { return ordering_; }
 
   void write_back(BaProblem& p) {
     for (std::size_t k = 0; k < p.keyframes.size(); ++k)
@@ -93,6 +118,10 @@ class BaState {
   std::vector<double> poses_, points_;
   std::vector<std::unique_ptr<ceres::CostFunction>> costs_;
   PoseManifold manifold_;
+  std::unique_ptr<ceres::Problem> ceres_;  // declared after the costs, losses and manifold it points to
+  std::shared_ptr<ceres::ParameterBlockOrdering> ordering_;
+  std::vector<ceres::ResidualBlockId> blocks_;  // per observation; nullptr = not in the problem
+  std::vector<int> pose_uses_, point_uses_;     // active observations per parameter block
 };
 
 }  // namespace
@@ -135,31 +164,33 @@ BaResult solve_local_ba(const PinholeCamera& cam, BaProblem& problem, const BaCo
   // when the alternation has settled).
   bool converged = false;
   double solved_alpha = alpha;
-  auto solve = [&](ceres::Problem& p, int iterations) {
-    if (iterations <= 0 || p.NumResidualBlocks() == 0) return;
+  auto solve = [&](ceres::Problem& ceres_problem, int iterations) {
+    if (iterations <= 0 || ceres_problem.NumResidualBlocks() == 0) return;
     if (converged && alpha == solved_alpha) return;
     options.max_num_iterations = iterations;
     ceres::Solver::Summary summary;
-    ceres::Solve(options, &p, &summary);
+    ceres::Solve(options, &ceres_problem, &summary);
     result.solver_iterations += static_cast<int>(summary.iterations.size()) - 1;
     converged = summary.termination_type == ceres::CONVERGENCE;
     solved_alpha = alpha;
   };
 
-  // Phase 1: every observation; adaptive alpha alternates with short solves on the same problem.
+  // Phase 1: every observation; adaptive alpha alternates with short solves on the same problem (the losses
+  // are re-evaluated by every solver iteration, so changing their alpha between solves is all it takes).
   std::vector<bool> active(n, true);
-  {
-    auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
-    auto p = state.build(active, ordering.get());
-    options.linear_solver_ordering = ordering;
-    if (adaptive) {
-      for (int outer = 0; outer < cfg.outer_iterations; ++outer) {
+  state.build(active);
+  options.linear_solver_ordering = state.ordering();
+  if (adaptive) {
+    for (int outer = 0; outer < cfg.outer_iterations; ++outer) {
+      if (outer > 0 || cfg.alpha_start != AlphaStart::SolveFirst) {
         refit_alpha(active);
-        solve(*p, cfg.iterations);
+      } else {
+        result.alpha_per_iteration.push_back(alpha);  // AlphaStart::SolveFirst: barron_alpha, no fit yet
       }
-    } else {
-      solve(*p, cfg.outer_iterations * cfg.iterations);
+      solve(state.ceres_problem(), cfg.iterations);
     }
+  } else {
+    solve(state.ceres_problem(), cfg.outer_iterations * cfg.iterations);
   }
 
   // Outlier gate on the state after phase 1.
@@ -174,17 +205,18 @@ BaResult solve_local_ba(const PinholeCamera& cam, BaProblem& problem, const BaCo
   if (cfg.remove_outliers) {
     std::vector<bool> outlier;
     gate(outlier);
-    for (std::size_t j = 0; j < n; ++j) active[j] = !outlier[j];
+    for (std::size_t j = 0; j < n; ++j) {
+      if (!outlier[j]) continue;
+      active[j] = false;
+      state.deactivate(j);
+      converged = false;  // the set of observations changed
+    }
   }
 
-  // Phase 2: refine on the surviving observations.
+  // Phase 2: refine on the surviving observations (same problem, outliers removed).
   if (cfg.refine_iterations > 0) {
-    auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
-    auto p = state.build(active, ordering.get());
-    options.linear_solver_ordering = ordering;
-    converged = false;  // the set of observations changed
     if (adaptive) refit_alpha(active);
-    solve(*p, cfg.refine_iterations);
+    solve(state.ceres_problem(), cfg.refine_iterations);
   }
 
   state.write_back(problem);

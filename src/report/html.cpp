@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <fstream>
 #include <iterator>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 namespace varslam::report {
 
@@ -59,6 +61,19 @@ std::optional<std::string> file_data_uri(const std::filesystem::path& file, cons
   return "data:" + mime + ";base64," + base64_encode(bytes);
 }
 
+std::optional<std::string> image_data_uri(const std::filesystem::path& file, int max_width) {
+  if (!std::filesystem::exists(file)) return std::nullopt;
+  cv::Mat img = cv::imread(file.string(), cv::IMREAD_COLOR);
+  if (img.empty()) return std::nullopt;
+  if (max_width > 0 && img.cols > max_width) {
+    const double s = static_cast<double>(max_width) / img.cols;
+    cv::resize(img, img, cv::Size(), s, s, cv::INTER_AREA);
+  }
+  std::vector<std::uint8_t> bytes;
+  if (!cv::imencode(".jpg", img, bytes, {cv::IMWRITE_JPEG_QUALITY, 85})) return std::nullopt;
+  return "data:image/jpeg;base64," + base64_encode(bytes);
+}
+
 std::string inline_svg(const Plot& plot) {
   std::string svg = render_svg(plot);
   const auto start = svg.find("<svg");
@@ -79,9 +94,9 @@ std::string page_head(std::string_view title) {
          "h1{font-size:22px}h2{font-size:18px;margin-top:28px;border-bottom:1px solid #ccc}\n"
          "table{border-collapse:collapse;margin:8px 0}td,th{border:1px solid #bbb;padding:3px 8px;"
          "text-align:right;font-size:13px}th{background:#eee}td.l,th.l{text-align:left}\n"
-         ".plots{display:flex;flex-wrap:wrap;gap:12px}.plots svg{border:1px solid #ddd;background:#fff}\n"
+         ".plots{display:flex;flex-wrap:wrap;gap:12px;align-items:flex-start}figure{margin:0}.plots svg{border:1px solid #ddd;background:#fff}\n"
          ".note{color:#666;font-size:13px}img.preview{max-width:100%;border:1px solid #ddd}\n"
-         "code{background:#f4f4f4;padding:1px 4px;font-size:12px}\n"
+         "code{background:#f4f4f4;padding:1px 4px;font-size:12px}pre{overflow-x:auto;font-size:12px}\n"
          "</style>\n</head>\n";
 }
 

@@ -8,8 +8,10 @@
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
+#include <csignal>
 #include <cstring>
 #include <map>
+#include <thread>
 
 #include "core/error.hpp"
 
@@ -23,6 +25,7 @@ using Clock = std::chrono::steady_clock;
 struct Running {
   std::size_t index = 0;
   Clock::time_point start;
+  bool killed = false;  // by the timeout
 };
 
 // Spawns one task with stdout+stderr redirected to its log; returns the pid or -1 (error filled in).
@@ -82,10 +85,10 @@ std::vector<ProcessOutcome> run_processes(const std::vector<ProcessTask>& tasks,
         continue;
       }
       if (!ready) continue;
-      // Mark before spawning so a spawn failure is not retried.
-      out[i].state = State::Failed;
+      out[i].state = State::Running;
       const pid_t pid = spawn_task(tasks[i], out[i].error);
       if (pid < 0) {
+        out[i].state = State::Failed;  // not retried
         finish(i);
         continue;
       }
@@ -101,23 +104,37 @@ std::vector<ProcessOutcome> run_processes(const std::vector<ProcessTask>& tasks,
     }
     int status = 0;
     pid_t pid = -1;
-    do {
-      pid = waitpid(-1, &status, 0);
-    } while (pid < 0 && errno == EINTR);
-    if (pid < 0) throw InputError(std::string("run_processes: waitpid failed: ") + std::strerror(errno));
+    // Poll (20 ms) rather than block, so children past their timeout can be killed.
+    while (true) {
+      pid = waitpid(-1, &status, WNOHANG);
+      if (pid > 0) break;
+      if (pid < 0 && errno != EINTR)
+        throw InputError(std::string("run_processes: waitpid failed: ") + std::strerror(errno));
+      const auto now = Clock::now();
+      for (auto& [child, r] : running) {
+        const double limit = tasks[r.index].timeout_seconds;
+        if (limit > 0 && !r.killed && std::chrono::duration<double>(now - r.start).count() > limit) {
+          kill(child, SIGKILL);
+          r.killed = true;
+        }
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
     const auto it = running.find(pid);
     if (it == running.end()) continue;  // not ours (a child the caller started otherwise)
     const std::size_t i = it->second.index;
+    const bool killed = it->second.killed;
     ProcessOutcome& o = out[i];
     o.wall_seconds = std::chrono::duration<double>(Clock::now() - it->second.start).count();
-    running.erase(it);
     if (WIFEXITED(status)) {
       o.exit_code = WEXITSTATUS(status);
     } else if (WIFSIGNALED(status)) {
       o.exit_code = 128 + WTERMSIG(status);
       o.error = std::string("killed by signal ") + std::to_string(WTERMSIG(status));
     }
-    o.state = o.exit_code == 0 ? State::Succeeded : State::Failed;
+    running.erase(it);
+    if (killed) o.error = "timed out after " + std::to_string(tasks[i].timeout_seconds) + " s";
+    o.state = o.exit_code == 0 && !killed ? State::Succeeded : State::Failed;
     if (o.state == State::Failed && o.error.empty()) o.error = "exit code " + std::to_string(o.exit_code);
     finish(i);
   }

@@ -14,10 +14,11 @@ struct ProcessTask {
   std::vector<std::string> argv;   // argv[0] is the program path (no PATH search)
   std::filesystem::path log_file;  // stdout and stderr go here (truncated); empty = /dev/null
   std::vector<std::size_t> after;  // indices of tasks that must succeed first; if one fails this one is skipped
+  double timeout_seconds = 0.0;    // > 0: killed (SIGKILL) after this long and counted as failed
 };
 
 struct ProcessOutcome {
-  enum class State { NotRun, Succeeded, Failed, Skipped } state = State::NotRun;
+  enum class State { NotRun, Running, Succeeded, Failed, Skipped } state = State::NotRun;
   int exit_code = -1;         // exit status, or 128 + signal number when killed
   double wall_seconds = 0.0;  // spawn to exit
   std::string error;          // spawn failure or the reason for skipping

@@ -60,6 +60,14 @@ std::string row(const std::string& name, const std::string& value) {
   return "<tr><th class=\"l\">" + html_escape(name) + "</th><td>" + html_escape(value) + "</td></tr>\n";
 }
 
+// Two plots side by side in a 1280 px wide window.
+Plot sized(Plot plot) {
+  const double scale = 600.0 / plot.options().width;
+  plot.options().width = 600;
+  plot.options().height = static_cast<int>(plot.options().height * scale);
+  return plot;
+}
+
 std::string cm(double metres) { return std::isfinite(metres) ? format_number(100.0 * metres, 2) + " cm" : "n/a"; }
 
 std::string key_numbers_table(const nlohmann::json& m) {
@@ -184,7 +192,7 @@ RunReportInputs load_run_report_inputs(const std::filesystem::path& run_dir,
   in.estimate = read_optional_trajectory(run_dir / "CameraTrajectory.txt", problems);
   if (!in.sequence_dir.empty()) {
     in.groundtruth = read_optional_trajectory(in.sequence_dir / "groundtruth.txt", problems);
-    in.preview_uri = file_data_uri(in.sequence_dir / "preview.png", "image/png");
+    in.preview_uri = image_data_uri(in.sequence_dir / "preview.png");
     if (std::filesystem::exists(in.sequence_dir / "scenario.json")) {
       try {
         in.scenario = read_json(in.sequence_dir / "scenario.json");
@@ -211,9 +219,8 @@ std::string render_run_report(const RunReportInputs& in) {
       // Same evaluation as the runner (TUM evaluate_ate), so the plot matches the numbers above.
       const AteResult ate = evaluate_ate(in.groundtruth, in.estimate);
       const Trajectory gt_span = clip_to(in.groundtruth, in.estimate);
-      h << "<figure id=\"plot-trajectory\">" << inline_svg(trajectory_top_view_plot(gt_span, ate)) << "</figure>\n";
-      Plot err = ate_error_plot(ate);
-      h << "<figure id=\"plot-ate-error\">" << inline_svg(err) << "</figure>\n";
+      h << "<figure id=\"plot-trajectory\">" << inline_svg(sized(trajectory_top_view_plot(gt_span, ate))) << "</figure>\n";
+      h << "<figure id=\"plot-ate-error\">" << inline_svg(sized(ate_error_plot(ate))) << "</figure>\n";
       if (!ate.pairs.empty()) t0 = ate.pairs.front().gt_timestamp;
       have_ate = true;
     } catch (const InputError& e) {
@@ -230,9 +237,9 @@ std::string render_run_report(const RunReportInputs& in) {
   if (alpha.series().empty())
     h << "<p class=\"note\" id=\"no-alpha\">No alpha per keyframe: the mapping kernel of this run is not adaptive.</p>\n";
   else
-    h << "<figure id=\"plot-alpha\">" << inline_svg(alpha) << "</figure>\n";
+    h << "<figure id=\"plot-alpha\">" << inline_svg(sized(alpha)) << "</figure>\n";
   const Plot timing = stage_timing_plot(in.metrics);
-  if (!timing.series().empty()) h << "<figure id=\"plot-timing\">" << inline_svg(timing) << "</figure>\n";
+  if (!timing.series().empty()) h << "<figure id=\"plot-timing\">" << inline_svg(sized(timing)) << "</figure>\n";
   h << "</div>\n";
 
   if (in.preview_uri) {

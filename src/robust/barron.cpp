@@ -35,35 +35,26 @@ double barron_weight(double x, double alpha, double c) {
   return kernel_d1(ShapeParams(alpha), z * z) / (c * c);
 }
 
-void barron_kernel(double s, double alpha, double c, double out[3]) {
-  const ShapeParams p(alpha);
+BarronKernel::BarronKernel(double alpha, double c) : alpha_(alpha), c_(c) {
   const double c2 = c * c;
-  const double q = s / c2;
-  out[0] = 2.0 * c2 * p.rho(q);
-  // kernel'' = (a/2 - 1) u^(a/2-2) / (c^2 b) = sign(a - 2) u^(a/2-2) / (2 c^2), since b = |a - 2|.
-  switch (p.shape) {
-    case Shape::L2:
-      out[1] = 1.0;
-      out[2] = 0.0;
-      return;
-    case Shape::Cauchy: {
-      const double inv_u = 1.0 / (1.0 + 0.5 * q);
-      out[1] = inv_u;
-      out[2] = -inv_u * inv_u / (2.0 * c2);
-      return;
-    }
-    case Shape::Welsch: {
-      const double e = std::exp(-0.5 * q);
-      out[1] = e;
-      out[2] = -e / (2.0 * c2);
-      return;
-    }
-    case Shape::General: break;
+  two_c2_ = 2.0 * c2;
+  half_a_ = 0.5 * alpha;
+  switch (detail::shape_of(alpha)) {
+    case Shape::L2: form_ = Form::L2; break;
+    case Shape::Cauchy: form_ = Form::Cauchy; break;
+    case Shape::Welsch: form_ = Form::Welsch; break;
+    case Shape::General:
+      form_ = std::abs(alpha - 1.0) < detail::kLimitEps ? Form::PseudoHuber : Form::General;
+      break;
   }
-  const double log_u = std::log1p(q * p.inv_b);
-  out[1] = std::exp((p.half_a - 1.0) * log_u);
-  const double d2 = std::exp((p.half_a - 2.0) * log_u) / (2.0 * c2);
-  out[2] = alpha < 2.0 ? -d2 : d2;
+  // Constants of the limits: b = 1 for pseudo-Huber, 2 for Cauchy (and Welsch's exp(-q/2)).
+  const double b = form_ == Form::PseudoHuber ? 1.0 : form_ == Form::General ? std::abs(alpha - 2.0) : 2.0;
+  inv_bc2_ = 1.0 / (b * c2);
+  value_scale_ = form_ == Form::General ? two_c2_ * b / alpha : 0.0;
+  // kernel'' = (a/2 - 1) u^(a/2-2) / (c^2 b) = sign(a - 2) u^(a/2-2) / (2 c^2), since b = |a - 2|.
+  d2_scale_ = (alpha < 2.0 ? -1.0 : 1.0) / two_c2_;
 }
+
+void barron_kernel(double s, double alpha, double c, double out[3]) { BarronKernel(alpha, c).evaluate(s, out); }
 
 }  // namespace varslam::robust

@@ -14,6 +14,7 @@
 //  - barron_weight(x) = rho'(x) / x = kernel'(x^2) / c^2.
 //  - Shapes: any finite alpha works (alpha > 2 included); alpha = 0 and alpha = 2 use their limits;
 //    alpha <= kWelschAlpha (or -infinity) is the Welsch limit a -> -inf.
+#include <cmath>
 #include <span>
 #include <vector>
 
@@ -31,7 +32,88 @@ double barron_weight(double x, double alpha, double c);
 
 /// Kernel on a squared whitened error s = e^T Omega e: out = {rho(s), rho'(s), rho''(s)} in the
 /// convention of ceres::LossFunction (rho(s) ~ s for small s): kernel(s) = 2 c^2 barron_rho(sqrt(s)).
+/// One-off convenience: solvers evaluating many residuals at one alpha should hold a BarronKernel.
 void barron_kernel(double s, double alpha, double c, double out[3]);
+
+/// barron_kernel for one shape alpha and scale c, with every constant that depends only on (alpha, c)
+/// precomputed: build it once per solve (or per alpha change), evaluate it per residual.
+/// Per evaluation: alpha = 2 plain arithmetic, alpha = 1 one sqrt, alpha = 0 one log1p, the Welsch limit
+/// one exp, any other alpha one log1p plus one exp or expm1 (the cost of one pow, measured, but exact
+/// near s = 0 where a pow-based u^(a/2) - 1 cancels). The special shapes are taken within 1e-12 of
+/// 0, 1 and 2, where they equal the general formula to double precision.
+class BarronKernel {
+ public:
+  explicit BarronKernel(double alpha, double c = 1.0);
+  double alpha() const { return alpha_; }
+  double c() const { return c_; }
+
+  /// out = {kernel(s), kernel'(s), kernel''(s)}, s >= 0.
+  void evaluate(double s, double out[3]) const {
+    switch (form_) {
+      case Form::L2:
+        out[0] = s;
+        out[1] = 1.0;
+        out[2] = 0.0;
+        return;
+      case Form::PseudoHuber: {
+        // u = 1 + q: kernel = 2 c^2 (sqrt(u) - 1) = 2 s / (sqrt(u) + 1) (no cancellation at small s),
+        // kernel' = u^(-1/2), kernel'' = -u^(-3/2) / (2 c^2).
+        const double r = std::sqrt(1.0 + s * inv_bc2_);
+        const double inv_r = 1.0 / r;
+        out[0] = 2.0 * s / (r + 1.0);
+        out[1] = inv_r;
+        out[2] = d2_scale_ * inv_r * inv_r * inv_r;
+        return;
+      }
+      case Form::Cauchy: {
+        // u = 1 + q / 2: kernel = 2 c^2 log(u), kernel' = 1 / u, kernel'' = -1 / (2 c^2 u^2).
+        const double t = s * inv_bc2_;
+        const double inv_u = 1.0 / (1.0 + t);
+        out[0] = two_c2_ * std::log1p(t);
+        out[1] = inv_u;
+        out[2] = d2_scale_ * inv_u * inv_u;
+        return;
+      }
+      case Form::Welsch: {
+        // Rare shape: a division keeps exp's argument correctly rounded (it amplifies argument errors).
+        const double x = -s / two_c2_;
+        const double e = std::exp(x);
+        // 1 - e cancels only for small arguments; there expm1 keeps the value exact.
+        out[0] = e > 0.5 ? -two_c2_ * std::expm1(x) : two_c2_ * (1.0 - e);
+        out[1] = e;
+        out[2] = d2_scale_ * e;
+        return;
+      }
+      case Form::General: break;
+    }
+    // u = 1 + q / b; w = u^(a/2) = exp(a/2 log u). kernel = 2 c^2 (b/a) (w - 1), kernel' = w / u,
+    // kernel'' = sign(a - 2) w / (2 c^2 u^2). w - 1 is taken from expm1 where it would cancel.
+    const double t = s * inv_bc2_;
+    const double h = half_a_ * std::log1p(t);
+    double w, w_minus_1;
+    if (std::abs(h) < 0.4) {
+      w_minus_1 = std::expm1(h);
+      w = w_minus_1 + 1.0;
+    } else {
+      w = std::exp(h);
+      w_minus_1 = w - 1.0;
+    }
+    const double inv_u = 1.0 / (1.0 + t);
+    out[0] = value_scale_ * w_minus_1;
+    out[1] = w * inv_u;
+    out[2] = d2_scale_ * out[1] * inv_u;
+  }
+
+ private:
+  enum class Form : unsigned char { L2, PseudoHuber, Cauchy, Welsch, General };
+  Form form_;
+  double alpha_, c_;
+  double inv_bc2_;      // 1 / (b c^2), b = |alpha - 2| (1 for pseudo-Huber, 2 for Cauchy and Welsch)
+  double two_c2_;       // 2 c^2
+  double value_scale_;  // 2 c^2 b / alpha
+  double half_a_;       // alpha / 2
+  double d2_scale_;     // sign(alpha - 2) / (2 c^2)
+};
 
 /// log Z(alpha) with Z = integral over [-tau, tau] of exp(-rho(x; alpha, 1)) dx (tau = +inf allowed for
 /// alpha >= 0), tabulated once on a grid of alpha.

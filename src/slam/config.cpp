@@ -62,6 +62,7 @@ SlamConfig slam_config_from(const Settings& s) {
   read_kernel(s, "tracking", c.tracking.kernel);
   c.tracking.motion_radius = setting_or<double>(s, "tracking.motion_radius", c.tracking.motion_radius);
   c.tracking.min_inliers_local_map = setting_or<int>(s, "tracking.min_inliers", c.tracking.min_inliers_local_map);
+  c.tracking.depth_edge_ratio = setting_or<double>(s, "depth.edge_ratio", c.tracking.depth_edge_ratio);
   c.tracking.lost_frames_before_reinit =
       setting_or<int>(s, "tracking.lost_frames_before_reinit", c.tracking.lost_frames_before_reinit);
 
@@ -70,6 +71,9 @@ SlamConfig slam_config_from(const Settings& s) {
   c.mapping.ba_outer_iterations = setting_or<int>(s, "mapping.ba_outer_iterations", c.mapping.ba_outer_iterations);
   c.mapping.ba_iterations = setting_or<int>(s, "mapping.ba_iterations", c.mapping.ba_iterations);
   c.mapping.ba_refine_iterations = setting_or<int>(s, "mapping.ba_refine_iterations", c.mapping.ba_refine_iterations);
+  c.mapping.max_ba_keyframes = setting_or<int>(s, "mapping.max_ba_keyframes", c.mapping.max_ba_keyframes);
+  if (c.mapping.max_ba_keyframes < 2)
+    throw ConfigError(fmt::format("{}: mapping.max_ba_keyframes must be >= 2", s.source.string()));
   c.mapping.cull_keyframes = setting_or<bool>(s, "mapping.cull_keyframes", c.mapping.cull_keyframes);
   if (c.mapping.ba_outer_iterations < 1 || c.mapping.ba_iterations < 1)
     throw ConfigError(fmt::format("{}: mapping.ba_outer_iterations and mapping.ba_iterations must be >= 1",

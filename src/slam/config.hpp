@@ -15,7 +15,8 @@ struct TrackingConfig {
   int min_inliers_local_map = 30;  // inliers after local-map tracking for the frame to count as tracked
   int max_local_keyframes = 80;
   int lost_frames_before_reinit = 3;  // failed recoveries before a new map segment starts
-  int vo_points = 100;             // temporary depth points in the last frame (RGB-D visual odometry)
+  int vo_points = 100;
+  double depth_edge_ratio = 0.0;   // > 0: drop the depth of keypoints on depth discontinuities (see frame.hpp)             // temporary depth points in the last frame (RGB-D visual odometry)
 };
 
 struct MappingConfig {
@@ -24,6 +25,7 @@ struct MappingConfig {
   int ba_iterations = 5;
   int ba_refine_iterations = 10;
   int triangulation_neighbours = 10;
+  int max_ba_keyframes = 20;  // optimised keyframes per Local BA (the most covisible); others observing stay fixed
   double keyframe_redundancy = 0.9;  // share of points seen by >= 3 other keyframes that makes a keyframe redundant
   bool cull_keyframes = true;
 };

@@ -47,7 +47,8 @@ void FrameFeatures::build_grid() {
 
 std::shared_ptr<FrameFeatures> make_frame_features(std::vector<cv::KeyPoint> keypoints, cv::Mat descriptors,
                                                    const cv::Mat& depth_m, const PinholeCamera& camera,
-                                                   double close_depth, std::shared_ptr<const ScaleInfo> scale) {
+                                                   double close_depth, std::shared_ptr<const ScaleInfo> scale,
+                                                   double depth_edge_ratio) {
   auto f = std::make_shared<FrameFeatures>();
   f->camera = camera;
   f->close_depth = close_depth;
@@ -62,7 +63,8 @@ std::shared_ptr<FrameFeatures> make_frame_features(std::vector<cv::KeyPoint> key
     const int v = static_cast<int>(std::lround(keypoints[i].pt.y));
     if (!depth_m.empty() && u >= 0 && v >= 0 && u < depth_m.cols && v < depth_m.rows) {
       const float d = depth_m.at<float>(v, u);
-      if (d > 0.0f && std::isfinite(d)) f->depth[i] = d;
+      if (d > 0.0f && std::isfinite(d) && !(depth_edge_ratio > 0 && on_depth_edge(depth_m, u, v, d, depth_edge_ratio)))
+        f->depth[i] = d;
     }
   }
   if (camera.has_distortion() && n > 0) {
@@ -76,6 +78,20 @@ std::shared_ptr<FrameFeatures> make_frame_features(std::vector<cv::KeyPoint> key
   f->keypoints = std::move(keypoints);
   f->build_grid();
   return f;
+}
+
+bool on_depth_edge(const cv::Mat& depth_m, int u, int v, float d, double ratio, int r) {
+  float lo = d, hi = d;
+  for (int y = std::max(0, v - r); y <= std::min(depth_m.rows - 1, v + r); ++y) {
+    const float* row = depth_m.ptr<float>(y);
+    for (int x = std::max(0, u - r); x <= std::min(depth_m.cols - 1, u + r); ++x) {
+      const float z = row[x];
+      if (z <= 0.0f) continue;
+      lo = std::min(lo, z);
+      hi = std::max(hi, z);
+    }
+  }
+  return hi - lo > ratio * d;
 }
 
 int Frame::num_tracked() const {

@@ -45,10 +45,17 @@ struct FrameFeatures {
 };
 
 /// Builds features from keypoints already extracted (and filtered) on `gray`: undistorts keypoint positions,
-/// looks up depth at each keypoint, computes u_right.
+/// looks up depth at each keypoint, computes u_right. With depth_edge_ratio > 0, a keypoint whose 5x5 depth
+/// neighbourhood spans more than that fraction of its depth sits on a depth discontinuity: its depth is
+/// dropped (it stays a 2-D observation), since a few pixels of colour/depth misregistration there put the
+/// point on the wrong surface.
 std::shared_ptr<FrameFeatures> make_frame_features(std::vector<cv::KeyPoint> keypoints, cv::Mat descriptors,
                                                    const cv::Mat& depth_m, const PinholeCamera& camera,
-                                                   double close_depth, std::shared_ptr<const ScaleInfo> scale);
+                                                   double close_depth, std::shared_ptr<const ScaleInfo> scale,
+                                                   double depth_edge_ratio = 0.0);
+
+/// True when the valid depths in the (2r+1)^2 window around (u, v) span more than ratio * d.
+bool on_depth_edge(const cv::Mat& depth_m, int u, int v, float d, double ratio, int r = 2);
 
 struct Frame {
   long id = 0;

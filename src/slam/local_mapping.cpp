@@ -249,7 +249,7 @@ void LocalMapper::local_ba(const KeyFramePtr& kf) {
   // Local window: the keyframe and its covisibles; fixed: others that see the window's points.
   std::vector<KeyFramePtr> local{kf};
   kf->ba_local_for_kf = kf->id();
-  for (const auto& n : kf->covisibles())
+  for (const auto& n : kf->best_covisibles(static_cast<std::size_t>(cfg_.max_ba_keyframes - 1)))
     if (!n->is_bad()) {
       n->ba_local_for_kf = kf->id();
       local.push_back(n);
@@ -261,13 +261,21 @@ void LocalMapper::local_ba(const KeyFramePtr& kf) {
         mp->ba_local_kf = kf->id();
         points.push_back(mp);
       }
-  std::vector<KeyFramePtr> fixed;
+  // Fixed keyframes: the ones seeing most of the window's points, capped like the window itself (in a small
+  // room every keyframe sees the window, and each would add residuals without adding much constraint).
+  std::map<KeyFramePtr, int, IdLess> fixed_count;
   for (const auto& mp : points)
     for (const auto& [k, idx] : mp->observations())
-      if (k->ba_local_for_kf != kf->id() && k->ba_fixed_for_kf != kf->id() && !k->is_bad()) {
-        k->ba_fixed_for_kf = kf->id();
-        fixed.push_back(k);
-      }
+      if (k->ba_local_for_kf != kf->id() && !k->is_bad()) fixed_count[k]++;
+  std::vector<std::pair<int, KeyFramePtr>> by_count;
+  for (const auto& [k, c] : fixed_count) by_count.emplace_back(c, k);
+  std::stable_sort(by_count.begin(), by_count.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::vector<KeyFramePtr> fixed;
+  for (const auto& [c, k] : by_count) {
+    if (fixed.size() >= static_cast<std::size_t>(cfg_.max_ba_keyframes)) break;
+    k->ba_fixed_for_kf = kf->id();
+    fixed.push_back(k);
+  }
   if (local.size() < 2 && fixed.empty()) return;  // nothing anchors the gauge yet
 
   optim::BaProblem problem;
@@ -336,7 +344,13 @@ void LocalMapper::local_ba(const KeyFramePtr& kf) {
   rec.observations = static_cast<int>(problem.observations.size());
   rec.outliers = outliers;
   rec.alpha_per_iteration = res.alpha_per_iteration;
-  rec.final_alpha = res.final_alpha;
+  // The alpha of the last alternation before the chi2 gate is the one that saw the movers; the refine solve
+  // re-fits on the gated inliers, which are near-Gaussian by construction.
+  rec.final_alpha = res.alpha_per_iteration.empty()
+                        ? res.final_alpha
+                        : res.alpha_per_iteration[std::min<std::size_t>(res.alpha_per_iteration.size(),
+                                                                         static_cast<std::size_t>(cfg_.ba_outer_iterations)) - 1];
+  rec.refine_alpha = res.final_alpha;
   rec.ms = ms_since(t0);
   std::lock_guard lock(stats_mutex_);
   stats_.ba.push_back(std::move(rec));

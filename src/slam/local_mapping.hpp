@@ -21,7 +21,8 @@ struct BaRecord {
   double timestamp = 0;
   int keyframes = 0, fixed_keyframes = 0, points = 0, observations = 0, outliers = 0;
   std::vector<double> alpha_per_iteration;
-  double final_alpha = 2.0;
+  double final_alpha = 2.0;   // alpha of the last alternation before the outlier gate
+  double refine_alpha = 2.0;  // alpha of the refine solve on the gated inliers
   double ms = 0;
 };
 

@@ -33,6 +33,11 @@ nlohmann::json timing_json(const std::vector<double>& v) {
   const auto [med, p95] = median_p95(v);
   return {{"median_ms", med}, {"p95_ms", p95}, {"count", v.size()}};
 }
+
+nlohmann::json count_json(const std::vector<double>& v) {
+  const auto [med, p95] = median_p95(v);
+  return {{"median", med}, {"p95", p95}, {"frames", v.size()}};
+}
 }  // namespace
 
 std::pair<double, double> median_p95(std::vector<double> v) {
@@ -164,7 +169,7 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const Slam
     ba_json.push_back({{"keyframe", b.keyframe_id}, {"timestamp", b.timestamp}, {"keyframes", b.keyframes},
                        {"fixed_keyframes", b.fixed_keyframes}, {"points", b.points},
                        {"observations", b.observations}, {"outliers", b.outliers},
-                       {"alpha_per_iteration", b.alpha_per_iteration}, {"final_alpha", b.final_alpha},
+                       {"alpha_per_iteration", b.alpha_per_iteration}, {"final_alpha", b.final_alpha}, {"refine_alpha", b.refine_alpha},
                        {"ms", b.ms}});
   }
   nlohmann::json m;
@@ -192,7 +197,7 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const Slam
     m["semantic"] = {{"detector", masker->detector_name()}, {"detector_runs", masker->detector_runs()},
                      {"asynchronous", sem.asynchronous}, {"frames_without_boxes", frames_without_boxes},
                      {"box_age", timing_json(box_age_ms)}, {"detector_latency", timing_json(det_latency_ms)},
-                     {"dropped_keypoints_per_frame", timing_json(dropped)}};
+                     {"dropped_keypoints_per_frame", count_json(dropped)}};
   }
 
   std::optional<std::filesystem::path> gt_path = options.groundtruth ? options.groundtruth : dataset.groundtruth();

@@ -59,7 +59,8 @@ Frame Tracker::build_frame(const RgbdFrame& input, FrameTimings& t) {
     desc = kept_desc;
     t.filter_ms = ms_since(t0);
   }
-  auto features = make_frame_features(std::move(kps), desc, input.depth, camera_, close_depth_, scale_);
+  auto features = make_frame_features(std::move(kps), desc, input.depth, camera_, close_depth_, scale_,
+                                      cfg_.tracking.depth_edge_ratio);
   return Frame(next_frame_id_++, input.timestamp, std::move(features));
 }
 
@@ -194,6 +195,8 @@ int Tracker::optimize_and_discard(Frame& cur, FrameTimings& t) {
   if (obs.size() < 3) return 0;
   optim::PoseOptimConfig pc;
   pc.kernel = cfg_.tracking.kernel;
+  // The dedicated 6-DoF solver gives the same pose as Ceres (tested against it) at 1.5-2x less cost.
+  pc.solver = optim::PoseSolver::Dedicated;
   const auto res = optim::optimize_pose(camera_, cur.T_cw, pts, obs, pc);
   cur.has_pose = true;
   int inliers = 0;

@@ -162,6 +162,41 @@ TEST(LocalBa, ObservationsBehindTheCameraAreOutliers) {
     }
 }
 
+TEST(LocalBa, RefineRunsAfterWholeBlocksLeaveTheProblem) {
+  // The refine phase removes outlier residual blocks from the one Ceres problem; a point that loses every
+  // observation leaves the problem (and the elimination ordering: Ceres rejects an ordering naming a block
+  // the problem does not have) with them.
+  const PinholeCamera cam;
+  for (KernelType kt : {KernelType::Huber, KernelType::BarronAdaptive}) {
+    SyntheticBa s = small_problem(3);
+    s.initial.points[0] = Eigen::Vector3d(0.0, 0.0, -5.0);  // behind every keyframe: all its observations go
+    BaProblem solved = s.initial;
+    const BaResult r = solve_local_ba(cam, solved, ba_config(kt));
+    for (std::size_t j = 0; j < solved.observations.size(); ++j)
+      if (solved.observations[j].point == 0) {
+        EXPECT_TRUE(r.outlier_observation[j]);  // so the point's block left the problem before the refine
+      }
+    EXPECT_LT(mean_translation_error(solved, s.truth), 0.5 * mean_translation_error(s.initial, s.truth));
+    EXPECT_LT(r.final_cost, r.initial_cost / 5);
+    EXPECT_GT(r.solver_iterations, 0);
+  }
+}
+
+TEST(LocalBa, SolveFirstStartsFromTheConfiguredAlpha) {
+  const PinholeCamera cam;
+  SyntheticBa s = small_problem(5);
+  add_gross_outliers(cam, s, 5);
+  BaConfig cfg = ba_config(KernelType::BarronAdaptive);
+  cfg.alpha_start = AlphaStart::SolveFirst;
+  cfg.kernel.barron_alpha = 0.5;
+  BaProblem solved = s.initial;
+  const BaResult r = solve_local_ba(cam, solved, cfg);
+  ASSERT_EQ(r.alpha_per_iteration.size(), static_cast<std::size_t>(cfg.outer_iterations + 1));
+  EXPECT_EQ(r.alpha_per_iteration[0], 0.5);  // no fit before the first solve
+  EXPECT_LT(r.alpha_per_iteration[1], 1.0);   // fitted on the solved state: the wrong matches pull it down
+  EXPECT_LT(mean_translation_error(solved, s.truth), 0.2 * mean_translation_error(s.initial, s.truth));
+}
+
 TEST(LocalBa, RejectsObservationOfMissingPoint) {
   SyntheticBa s = small_problem(3);
   s.initial.observations.push_back({0, static_cast<int>(s.initial.points.size()), {}});

@@ -122,3 +122,20 @@ TEST(Frame, GridSearchFindsKeypointsInRadiusAndLevel) {
 
 }  // namespace
 }  // namespace varslam::slam
+
+namespace varslam::slam {
+namespace {
+
+TEST(Frame, DepthEdgeTestFlagsDiscontinuitiesOnly) {
+  cv::Mat depth(40, 40, CV_32F, cv::Scalar(4.0f));
+  depth(cv::Rect(0, 0, 20, 40)).setTo(1.5f);  // a person at 1.5 m in front of a wall at 4 m
+  EXPECT_TRUE(on_depth_edge(depth, 20, 20, 4.0f, 0.1));   // right at the boundary
+  EXPECT_TRUE(on_depth_edge(depth, 19, 20, 1.5f, 0.1));
+  EXPECT_FALSE(on_depth_edge(depth, 30, 20, 4.0f, 0.1));  // inside the wall
+  EXPECT_FALSE(on_depth_edge(depth, 5, 20, 1.5f, 0.1));   // inside the person
+  depth.at<float>(30, 30) = 0.0f;                          // holes do not count as an edge
+  EXPECT_FALSE(on_depth_edge(depth, 31, 30, 4.0f, 0.1));
+}
+
+}  // namespace
+}  // namespace varslam::slam
