@@ -9,9 +9,8 @@
 int main(int argc, char** argv) {
   CLI::App app{"varslam: RGB-D visual SLAM that stays accurate where things move"};
   app.require_subcommand(1);
-  bool verbose = false;
-  app.add_flag("-v,--verbose", verbose, "Debug logging");
-  app.parse_complete_callback([&] { spdlog::set_level(verbose ? spdlog::level::debug : spdlog::level::info); });
+  // Subcommands run inside parse(), so the log level is set as soon as the flag is parsed.
+  app.add_flag_callback("-v,--verbose", [] { spdlog::set_level(spdlog::level::debug); }, "Debug logging");
   varslam::cli::add_demo_command(app);
   varslam::cli::add_run_command(app);
   varslam::cli::add_eval_command(app);

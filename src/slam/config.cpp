@@ -63,6 +63,7 @@ SlamConfig slam_config_from(const Settings& s) {
   c.tracking.motion_radius = setting_or<double>(s, "tracking.motion_radius", c.tracking.motion_radius);
   c.tracking.min_inliers_local_map = setting_or<int>(s, "tracking.min_inliers", c.tracking.min_inliers_local_map);
   c.tracking.depth_edge_ratio = setting_or<double>(s, "depth.edge_ratio", c.tracking.depth_edge_ratio);
+  c.tracking.close_keyframe_gap = setting_or<int>(s, "tracking.close_keyframe_gap", c.tracking.close_keyframe_gap);
   c.tracking.lost_frames_before_reinit =
       setting_or<int>(s, "tracking.lost_frames_before_reinit", c.tracking.lost_frames_before_reinit);
 

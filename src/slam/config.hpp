@@ -16,6 +16,7 @@ struct TrackingConfig {
   int max_local_keyframes = 80;
   int lost_frames_before_reinit = 3;  // failed recoveries before a new map segment starts
   int vo_points = 100;
+  int close_keyframe_gap = 5;      // frames between keyframes triggered by untracked close points
   double depth_edge_ratio = 0.0;   // > 0: drop the depth of keypoints on depth discontinuities (see frame.hpp)             // temporary depth points in the last frame (RGB-D visual odometry)
 };
 

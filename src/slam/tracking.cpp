@@ -371,13 +371,18 @@ bool Tracker::need_keyframe(const Frame& cur, int inliers) const {
     else ++untracked_close;
   }
   // Many close points seen but few of them in the map: a keyframe adds cheap, well-constrained structure.
-  const bool need_close = tracked_close < 100 && untracked_close > 70;
+  // ORB-SLAM3 would take one at every such frame; with a person close to the camera that is every frame (its
+  // keypoints are close and never tracked), flooding the map. A short gap keeps the rule for real new structure.
+  const bool need_close = tracked_close < 100 && untracked_close > 70 &&
+                          cur.id >= last_kf_frame_id_ + cfg_.tracking.close_keyframe_gap;
   const double ref_ratio = n_kfs < 2 ? 0.4 : 0.75;
   const long max_frames = std::max<long>(1, std::lround(cfg_.fps));
   const bool c1a = cur.id >= last_kf_frame_id_ + max_frames;
   const bool c1b = mapping_idle;
   const bool c1c = inliers < ref_matches * 0.25 || need_close;
   const bool c2 = (inliers < ref_matches * ref_ratio || need_close) && inliers > 15;
+  spdlog::debug("frame {}: inliers {} ref_matches {} close tracked {} untracked {} -> c1a {} c1c {} c2 {}", cur.id,
+                inliers, ref_matches, tracked_close, untracked_close, c1a, c1c, c2);
   if (!((c1a || c1b || c1c) && c2)) return false;
   if (mapping_idle) return true;
   sink_.interrupt_ba();
