@@ -194,18 +194,11 @@ SynthSummary generate(const SynthConfig& cfg, const std::filesystem::path& out_d
   // Far wall about 4.6 m ahead: most of the view stays within the 5.5 m depth range, as in an office.
   enclose(anchor.center + 4.6 * anchor.forward + 3.0 * anchor.right, 0.0);
   enclose(anchor.center + 4.6 * anchor.forward - 3.0 * anchor.right, 0.0);
-  // The room depends on the seed and the path only, never on the scenario: it is laid out around the movers
-  // of every scenario, so `static` and `walking` with one seed show the same room (a fair comparison).
-  std::vector<KeepOut> keep;
-  for (const std::string& name : scenario_names()) {
-    const Movers all = Movers::script(name, anchor, floor_y, span, pose_at, mix_seed(seed, 11));
-    for (const auto& p : all.extent_points()) enclose(p, 0.6);
-    const std::vector<KeepOut> k = all.keep_outs();
-    keep.insert(keep.end(), k.begin(), k.end());
-  }
+  for (const auto& p : movers.extent_points()) enclose(p, 0.6);
   room_lo.y() = ceiling_y;
   room_hi.y() = floor_y;
 
+  std::vector<KeepOut> keep = movers.keep_outs();
   for (std::size_t i = 0; i < n_frames; i += 5) keep.push_back({{poses[i].translation().x(), poses[i].translation().z()}, 0.6});
   Scene scene = build_static_scene(room_lo, room_hi, anchor, keep, mix_seed(seed, 22));
   movers.add_materials(scene, mix_seed(seed, 33));
