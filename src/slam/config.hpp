@@ -15,9 +15,9 @@ struct TrackingConfig {
   int min_inliers_local_map = 30;  // inliers after local-map tracking for the frame to count as tracked
   int max_local_keyframes = 80;
   int lost_frames_before_reinit = 3;  // failed recoveries before a new map segment starts
-  int vo_points = 100;
+  int vo_points = 100;             // temporary depth points in the last frame (RGB-D visual odometry)
   int close_keyframe_gap = 5;      // frames between keyframes triggered by untracked close points
-  double depth_edge_ratio = 0.0;   // > 0: drop the depth of keypoints on depth discontinuities (see frame.hpp)             // temporary depth points in the last frame (RGB-D visual odometry)
+  double depth_edge_ratio = 0.1;   // > 0: drop the depth of keypoints on depth discontinuities (see frame.hpp)
 };
 
 struct MappingConfig {

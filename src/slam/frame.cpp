@@ -63,8 +63,10 @@ std::shared_ptr<FrameFeatures> make_frame_features(std::vector<cv::KeyPoint> key
     const int v = static_cast<int>(std::lround(keypoints[i].pt.y));
     if (!depth_m.empty() && u >= 0 && v >= 0 && u < depth_m.cols && v < depth_m.rows) {
       const float d = depth_m.at<float>(v, u);
-      if (d > 0.0f && std::isfinite(d) && !(depth_edge_ratio > 0 && on_depth_edge(depth_m, u, v, d, depth_edge_ratio)))
-        f->depth[i] = d;
+      if (d > 0.0f && std::isfinite(d)) {
+        if (depth_edge_ratio > 0 && on_depth_edge(depth_m, u, v, d, depth_edge_ratio)) ++f->depth_edge_rejected;
+        else f->depth[i] = d;
+      }
     }
   }
   if (camera.has_distortion() && n > 0) {

@@ -30,6 +30,7 @@ struct FrameFeatures {
   std::shared_ptr<const ScaleInfo> scale;
   PinholeCamera camera;
   double close_depth = 3.0;  // metres: points closer than this are "close" (reliable depth)
+  int depth_edge_rejected = 0;  // keypoints whose depth was dropped by the depth-edge test
 
   static constexpr int kGridCols = 64, kGridRows = 48;
   std::vector<std::vector<int>> grid;  // kGridCols * kGridRows cells of keypoint indices

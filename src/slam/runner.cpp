@@ -117,6 +117,7 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const Slam
     log.new_segment = out.new_segment;
     log.keypoints = out.keypoints;
     log.inliers = out.inliers;
+    log.depth_edge_rejected = out.depth_edge_rejected;
     log.load_ms = load_ms;
     log.timings = out.timings;
     logs.push_back(log);
@@ -152,7 +153,7 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const Slam
   write_tum_trajectory(system.keyframe_trajectory(), out_dir / "KeyFrameTrajectory.txt");
   write_map_ply(system.map(), out_dir / "map.ply");
 
-  std::vector<double> load, extract, filt, match, pose, track, kf_ms, ba_ms;
+  std::vector<double> load, extract, filt, match, pose, track, kf_ms, ba_ms, edge_rejected, n_kps;
   for (const auto& l : logs) {
     load.push_back(l.load_ms);
     extract.push_back(l.timings.extract_ms);
@@ -160,6 +161,8 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const Slam
     match.push_back(l.timings.match_ms);
     pose.push_back(l.timings.pose_ms);
     track.push_back(l.timings.track_ms);
+    edge_rejected.push_back(l.depth_edge_rejected);
+    n_kps.push_back(l.keypoints);
   }
   const MappingStats ms = system.mapping_stats();
   kf_ms = ms.keyframe_ms;
@@ -193,6 +196,8 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const Slam
                   {"pose_optimization", timing_json(pose)}, {"tracking", timing_json(track)},
                   {"keyframe_processing", timing_json(kf_ms)}, {"local_ba", timing_json(ba_ms)}};
   m["local_ba"] = ba_json;
+  m["keypoints_per_frame"] = count_json(n_kps);
+  m["depth_edge_rejected_per_frame"] = count_json(edge_rejected);
   if (masker) {
     m["semantic"] = {{"detector", masker->detector_name()}, {"detector_runs", masker->detector_runs()},
                      {"asynchronous", sem.asynchronous}, {"frames_without_boxes", frames_without_boxes},

@@ -19,7 +19,7 @@ struct FrameLog {
   double timestamp = 0;
   TrackState state = TrackState::NotInitialized;
   bool keyframe = false, new_segment = false;
-  int keypoints = 0, inliers = 0;
+  int keypoints = 0, inliers = 0, depth_edge_rejected = 0;
   double load_ms = 0;
   FrameTimings timings;
 };

@@ -69,6 +69,7 @@ TrackOutcome Tracker::track(const RgbdFrame& input) {
   const auto t_start = Clock::now();
   Frame cur = build_frame(input, out.timings);
   out.keypoints = static_cast<int>(cur.features->size());
+  out.depth_edge_rejected = cur.features->depth_edge_rejected;
 
   std::shared_lock map_lock(map_.update_mutex());
   if (state_ == TrackState::NotInitialized) {
