@@ -7,31 +7,30 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "io/text_lines.hpp"
 
 namespace varslam {
 
 BoxesByTime read_boxes_file(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  if (!in) throw InputError(fmt::format("{}: cannot open boxes file", file.string()));
   BoxesByTime out;
-  std::string line;
-  int line_no = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
-    const auto first = line.find_first_not_of(" \t\r");
-    if (first == std::string::npos || line[first] == '#') continue;
-    std::istringstream ss(line);
+  for_each_data_line(file, "boxes file", [&](const TextLine& l) {
     Detection d;
-    float x = 0, y = 0, w = 0, h = 0;
-    if (!(ss >> d.timestamp >> d.label >> d.score >> x >> y >> w >> h))
-      throw InputError(fmt::format("{}:{}: expected 'timestamp label score x y w h', got '{}'", file.string(),
-                                   line_no, line));
-    if (!std::isfinite(d.timestamp) || !std::isfinite(x) || !std::isfinite(y) || w < 0 || h < 0 ||
-        !std::isfinite(w) || !std::isfinite(h))
-      throw InputError(fmt::format("{}:{}: non-finite value or negative box size", file.string(), line_no));
-    d.box = cv::Rect2f(x, y, w, h);
+    double v[6] = {};  // timestamp score x y w h
+    bool ok = l.tokens.size() == 7;
+    if (ok) d.label = l.tokens[1];
+    const int token_of[6] = {0, 2, 3, 4, 5, 6};
+    for (int k = 0; ok && k < 6; ++k) ok = parse_double(l.tokens[token_of[k]], v[k]);
+    if (!ok)
+      throw InputError(fmt::format("{}: expected 'timestamp label score x y w h', got '{}'", l.where, *l.text));
+    for (double x : v)
+      if (!std::isfinite(x)) throw InputError(fmt::format("{}: non-finite value in '{}'", l.where, *l.text));
+    if (v[4] < 0 || v[5] < 0) throw InputError(fmt::format("{}: negative box size in '{}'", l.where, *l.text));
+    d.timestamp = v[0];
+    d.score = static_cast<float>(v[1]);
+    d.box = cv::Rect2f(static_cast<float>(v[2]), static_cast<float>(v[3]), static_cast<float>(v[4]),
+                       static_cast<float>(v[5]));
     out[d.timestamp].push_back(std::move(d));
-  }
+  });
   return out;
 }
 

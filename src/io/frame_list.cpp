@@ -9,33 +9,15 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "io/text_lines.hpp"
 
 namespace varslam {
 namespace {
 
-// strtod accepts "nan"/"inf": they get the precise "not finite" message instead of "malformed".
-bool parse_double(const std::string& token, double& out) {
-  char* end = nullptr;
-  out = std::strtod(token.c_str(), &end);
-  return end != token.c_str() && *end == '\0';
-}
-
-// Calls fn(tokens, where) for each non-comment line.
+// Calls fn(tokens, where, line) for each non-comment line.
 template <typename Fn>
 void for_each_line(const std::filesystem::path& file, Fn&& fn) {
-  std::ifstream in(file);
-  if (!in) throw InputError(fmt::format("{}: cannot open list file", file.string()));
-  std::string line;
-  int line_no = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
-    const auto first = line.find_first_not_of(" \t\r");
-    if (first == std::string::npos || line[first] == '#') continue;
-    std::istringstream ss(line);
-    std::vector<std::string> tokens;
-    for (std::string t; ss >> t;) tokens.push_back(t);
-    fn(tokens, fmt::format("{}:{}", file.string(), line_no), line);
-  }
+  for_each_data_line(file, "list file", [&](const TextLine& l) { fn(l.tokens, l.where, *l.text); });
 }
 
 double timestamp_or_throw(const std::string& token, const std::string& where, const std::string& line,

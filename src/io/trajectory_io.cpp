@@ -11,45 +11,24 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "io/text_lines.hpp"
 
 namespace varslam {
 namespace {
 
-// strtod accepts "nan"/"inf", so they reach the finiteness check with a precise message instead of
-// being reported as a malformed line.
-bool parse_double(const std::string& token, double& out) {
-  char* end = nullptr;
-  out = std::strtod(token.c_str(), &end);
-  return end != token.c_str() && *end == '\0';
-}
-
 }  // namespace
 
 Trajectory read_tum_trajectory(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  if (!in) throw InputError(fmt::format("{}: cannot open trajectory file", file.string()));
   Trajectory out;
-  std::string line;
-  int line_no = 0;
   int prev_line = 0;
   int duplicates = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
-    const auto first = line.find_first_not_of(" \t\r");
-    if (first == std::string::npos || line[first] == '#') continue;
-    std::istringstream ss(line);
+  for_each_data_line(file, "trajectory file", [&](const TextLine& l) {
+    const std::string& line = *l.text;
+    const int line_no = l.number;
     std::array<double, 8> v{};
-    std::string token;
-    std::size_t n = 0;
-    bool ok = true;
-    while (ss >> token) {
-      if (n == v.size() || !parse_double(token, v[n])) {
-        ok = false;
-        break;
-      }
-      ++n;
-    }
-    if (!ok || n != v.size())
+    bool ok = l.tokens.size() == v.size();
+    for (std::size_t n = 0; ok && n < v.size(); ++n) ok = parse_double(l.tokens[n], v[n]);
+    if (!ok)
       throw InputError(fmt::format("{}:{}: expected 'timestamp tx ty tz qx qy qz qw', got '{}'", file.string(),
                                    line_no, line));
     for (double x : v)
@@ -78,7 +57,7 @@ Trajectory read_tum_trajectory(const std::filesystem::path& file) {
       out.push_back(p);
     }
     prev_line = line_no;
-  }
+  });
   if (duplicates > 0)
     spdlog::debug("{}: {} repeated timestamps, kept the later pose of each", file.string(), duplicates);
   return out;

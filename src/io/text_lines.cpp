@@ -1,0 +1,38 @@
+#include "io/text_lines.hpp"
+
+#include <fmt/format.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "core/error.hpp"
+
+namespace varslam {
+
+bool parse_double(const std::string& token, double& out) {
+  char* end = nullptr;
+  out = std::strtod(token.c_str(), &end);
+  return end != token.c_str() && *end == '\0';
+}
+
+void for_each_data_line(const std::filesystem::path& file, const std::string& what,
+                        const std::function<void(const TextLine&)>& fn) {
+  std::ifstream in(file);
+  if (!in) throw InputError(fmt::format("{}: cannot open {}", file.string(), what));
+  std::string line;
+  TextLine tl;
+  tl.text = &line;
+  while (std::getline(in, line)) {
+    ++tl.number;
+    const auto first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line[first] == '#') continue;
+    std::istringstream ss(line);
+    tl.tokens.clear();
+    for (std::string t; ss >> t;) tl.tokens.push_back(t);
+    tl.where = fmt::format("{}:{}", file.string(), tl.number);
+    fn(tl);
+  }
+}
+
+}  // namespace varslam
