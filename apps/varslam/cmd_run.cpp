@@ -13,6 +13,7 @@ void add_run_command(CLI::App& app) {
     bool realtime = false, pace = false, quiet = false;
     std::size_t first = 0, max_frames = SIZE_MAX;
     std::vector<std::string> overrides;
+    std::vector<std::size_t> debug_frames;
   };
   auto o = std::make_shared<Opts>();
   auto* cmd = app.add_subcommand("run", "Run SLAM on a dataset folder and write trajectory, map and metrics");
@@ -26,6 +27,9 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("--max-frames,-n", o->max_frames, "Process at most this many frames");
   cmd->add_option("--set", o->overrides, "Override a setting: section.key=value (repeatable)");
   cmd->add_flag("--quiet,-q", o->quiet, "No progress line");
+  cmd->add_option("--debug-frames", o->debug_frames,
+                  "Frame indices for which the semantic filter's stages are drawn into <out>/semantic_stages_*.png")
+      ->delimiter(',');
   cmd->callback([o] {
     std::optional<std::filesystem::path> sfile;
     if (!o->settings.empty()) sfile = o->settings;
@@ -39,6 +43,7 @@ void add_run_command(CLI::App& app) {
     ro.first = o->first;
     ro.max_frames = o->max_frames;
     ro.progress = !o->quiet;
+    ro.debug_frames.insert(o->debug_frames.begin(), o->debug_frames.end());
     if (!o->groundtruth.empty()) ro.groundtruth = o->groundtruth;
     const slam::RunSummary s = slam::run_slam(*dataset, settings, cfg, ro, o->out);
     write_report_for_run(s.out_dir, o->dataset);

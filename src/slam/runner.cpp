@@ -14,6 +14,9 @@
 #include "eval/rpe.hpp"
 #include "io/trajectory_io.hpp"
 #include "semantic/dynamic_keypoint_masker.hpp"
+#include "semantic/filter_stages_image.hpp"
+
+#include <opencv2/imgcodecs.hpp>
 
 namespace varslam::slam {
 
@@ -86,6 +89,11 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const Slam
         ++frames_without_boxes;
       }
       dropped.push_back(r.stats.dropped);
+      if (options.debug_frames.count(f.index)) {
+        // The paper's Fig. 3: all keypoints | keypoints in boxes | keypoints kept after the depth test.
+        const auto file = out_dir / fmt::format("semantic_stages_{:06d}.png", f.index);
+        cv::imwrite(file.string(), semantic::draw_filter_stages(f.bgr, kps, r.boxes, r.keep));
+      }
       return r.keep;
     });
   }

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <set>
 
 #include "io/dataset.hpp"
 #include "io/settings.hpp"
@@ -19,6 +20,7 @@ struct RunOptions {
   std::size_t max_frames = SIZE_MAX;
   bool progress = true;        // progress lines on stderr
   std::optional<std::filesystem::path> groundtruth;  // overrides the dataset's groundtruth.txt
+  std::set<std::size_t> debug_frames;  // frame indices for which the semantic filter's stages are drawn
 };
 
 struct RunSummary {
