@@ -3,5 +3,5 @@
 # (a short synthetic dynamic scene generated on the spot).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/build.sh
+scripts/build.sh varslam_cli  # the CLI only; run_tests.sh builds the tests
 exec build/bin/varslam demo --out out/demo "$@"
