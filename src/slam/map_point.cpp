@@ -79,30 +79,28 @@ std::shared_ptr<KeyFrame> MapPoint::reference_keyframe() const {
   return reference_;
 }
 
-void MapPoint::set_bad() {
+std::optional<Observations> MapPoint::detach(const std::shared_ptr<MapPoint>& replacement) {
   Observations obs;
-  {
-    std::lock_guard lock(mutex_);
-    if (bad_.exchange(true)) return;
-    obs.swap(observations_);
-    n_obs_ = 0;
-    reference_.reset();
-  }
-  for (const auto& [kf, idx] : obs) kf->erase_map_point(idx);
+  std::lock_guard lock(mutex_);
+  if (bad_.exchange(true)) return std::nullopt;
+  obs.swap(observations_);
+  n_obs_ = 0;
+  reference_.reset();
+  replaced_by_ = replacement;
+  return obs;
+}
+
+void MapPoint::set_bad() {
+  const auto obs = detach(nullptr);
+  if (!obs) return;
+  for (const auto& [kf, idx] : *obs) kf->erase_map_point(idx);
 }
 
 void MapPoint::replace_with(const std::shared_ptr<MapPoint>& other) {
   if (other.get() == this) return;
-  Observations obs;
-  {
-    std::lock_guard lock(mutex_);
-    if (bad_.exchange(true)) return;
-    obs.swap(observations_);
-    n_obs_ = 0;
-    reference_.reset();
-    replaced_by_ = other;
-  }
-  for (const auto& [kf, idx] : obs) {
+  const auto obs = detach(other);
+  if (!obs) return;
+  for (const auto& [kf, idx] : *obs) {
     if (other->index_in(kf.get()) < 0) {
       kf->replace_map_point(idx, other);
       other->add_observation(kf, idx, kf->features().has_depth(idx));

@@ -7,6 +7,7 @@
 #include <memory>
 #include <mutex>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <vector>
 
 #include "slam/id_order.hpp"
@@ -68,6 +69,9 @@ class MapPoint {
   long ba_local_kf = -1;            // local mapping scratch
 
  private:
+  /// Marks the point bad and hands back its observations; nullopt if it already was bad.
+  std::optional<Observations> detach(const std::shared_ptr<MapPoint>& replacement);
+
   const long id_;
   const long first_kf_id_;
   mutable std::mutex mutex_;

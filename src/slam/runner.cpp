@@ -102,7 +102,6 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const Slam
   std::vector<FrameLog> logs;
   logs.reserve(count);
   const auto t_start = Clock::now();
-  const double frame_period = 1.0 / std::max(1e-6, settings.fps);
   std::size_t n = 0;
   double first_stamp = 0;
   auto last_progress = Clock::now();
@@ -141,7 +140,6 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const Slam
   system.finish();
   const double wall = std::chrono::duration<double>(Clock::now() - t_start).count();
   if (options.progress) fmt::print(stderr, "\n");
-  (void)frame_period;
 
   RunSummary sum;
   sum.out_dir = out_dir;

@@ -2,25 +2,11 @@
 
 namespace varslam::slam {
 
-namespace {
-std::shared_ptr<const ScaleInfo> scale_of(const SlamConfig& cfg) {
-  auto s = std::make_shared<ScaleInfo>();
-  s->n_levels = cfg.orb.n_levels;
-  s->scale_factor = cfg.orb.scale_factor;
-  s->log_scale_factor = std::log(cfg.orb.scale_factor);
-  double f = 1.0;
-  for (int l = 0; l < cfg.orb.n_levels; ++l, f *= cfg.orb.scale_factor) {
-    s->scale_factors.push_back(f);
-    s->level_sigma2.push_back(f * f);
-    s->inv_level_sigma2.push_back(1.0 / (f * f));
-  }
-  return s;
-}
-}  // namespace
-
 System::System(const SlamConfig& cfg, const PinholeCamera& camera, double close_depth, RunMode mode)
-    : cfg_(cfg), mode_(mode), mapper_(cfg.mapping, map_, scale_of(cfg), close_depth),
-      tracker_(cfg, camera, close_depth, map_, mapper_) {
+    // The tracker only stores its keyframe sink here; the mapper takes the pyramid facts from the tracker's
+    // extractor, so both stages use one ScaleInfo.
+    : cfg_(cfg), mode_(mode), tracker_(cfg, camera, close_depth, map_, mapper_),
+      mapper_(cfg.mapping, map_, tracker_.scale(), close_depth) {
   if (mode_ == RunMode::RealTime) mapper_.start();
 }
 

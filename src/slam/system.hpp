@@ -51,8 +51,8 @@ class System {
   SlamConfig cfg_;
   RunMode mode_;
   Map map_;
+  Tracker tracker_;     // constructed first: the mapper takes its ScaleInfo
   LocalMapper mapper_;
-  Tracker tracker_;
 };
 
 }  // namespace varslam::slam
