@@ -90,6 +90,10 @@ SemanticSettings semantic_settings(const Settings& s) {
   sec.check(f.bin_m > 0, "bin_m", "must be > 0");
   sec.read("peak_fraction", f.peak_fraction);
   sec.read("sample_step", f.sample_step);
+  sec.read("silhouette_margin_px", f.silhouette_margin_px);
+  sec.check(f.silhouette_margin_px >= 0, "silhouette_margin_px", "must be >= 0");
+  sec.read("min_exclusive_share", f.min_exclusive_share);
+  sec.check(f.min_exclusive_share >= 0 && f.min_exclusive_share <= 1, "min_exclusive_share", "must be in [0, 1]");
 
   sec.read("asynchronous", out.asynchronous);
   sec.read("propagate_boxes", out.propagate_boxes);

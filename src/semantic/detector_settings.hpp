@@ -15,6 +15,8 @@
 //     boxes_file: boxes.txt
 //     box_enlarge: 0.1
 //     depth_band_m: 0.5
+//     silhouette_margin_px: 0   # e.g. 5: drop background keypoints this close to the person's pixels (0 = off)
+//     min_exclusive_share: 1    # e.g. 0.2: overlapping boxes also get a person depth from their own part (1 = off)
 //     asynchronous: true        # false: wait for each frame's detections (deterministic)
 //     propagate_boxes: true     # shift stale boxes by optical flow
 #include "io/settings.hpp"

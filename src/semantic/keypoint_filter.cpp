@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <climits>
 #include <cmath>
+#include <opencv2/imgproc.hpp>
 
 namespace varslam::semantic {
 namespace {
@@ -11,7 +12,8 @@ constexpr int kMaxSamplesPerBox = 4096;  // plenty for a 0.1 m histogram; keeps 
 
 struct BoxDepth {
   cv::Rect rect;
-  float person_m = 0.0f;  // 0: the box has no valid depth
+  PersonDepth person;      // whole_m == 0: the box has no valid depth
+  cv::Mat dist_to_person;  // per pixel of rect (CV_32F); empty when the silhouette margin is off
 };
 
 bool valid_depth(float d, const FilterConfig& cfg) {
@@ -28,34 +30,46 @@ cv::Rect enlarge_box(const cv::Rect2f& box, float fraction, const cv::Size& imag
   return cv::Rect(tl, br) & cv::Rect(0, 0, image_size.width, image_size.height);
 }
 
-float estimate_person_depth(const cv::Mat& depth_m, const cv::Rect& roi_in, const FilterConfig& cfg) {
-  if (depth_m.empty() || depth_m.type() != CV_32FC1 || cfg.bin_m <= 0.0f) return 0.0f;
-  const cv::Rect roi = roi_in & cv::Rect(0, 0, depth_m.cols, depth_m.rows);
-  if (roi.area() <= 0) return 0.0f;
+namespace {
+
+// Depth histogram of a box (one guard bin at each end), from every step-th pixel that no excluded rect covers.
+struct DepthHistogram {
+  std::vector<int> bins;
+  int total = 0;
+};
+
+DepthHistogram depth_histogram(const cv::Mat& depth_m, const cv::Rect& roi, const std::vector<cv::Rect>& exclude,
+                               const FilterConfig& cfg) {
+  const int n_bins = std::max(1, static_cast<int>(std::ceil((cfg.max_depth_m - cfg.min_depth_m) / cfg.bin_m)));
+  DepthHistogram h;
+  h.bins.assign(static_cast<std::size_t>(n_bins) + 2, 0);
   int step = std::max(1, cfg.sample_step);
   while (roi.area() / (step * step) > kMaxSamplesPerBox) ++step;
-
-  const int n_bins = std::max(1, static_cast<int>(std::ceil((cfg.max_depth_m - cfg.min_depth_m) / cfg.bin_m)));
-  std::vector<int> hist(static_cast<std::size_t>(n_bins) + 2, 0);  // one guard bin at each end
-  int total = 0;
   for (int y = roi.y; y < roi.y + roi.height; y += step) {
     const float* row = depth_m.ptr<float>(y);
     for (int x = roi.x; x < roi.x + roi.width; x += step) {
       const float d = row[x];
       if (!valid_depth(d, cfg)) continue;
+      const cv::Point p(x, y);
+      if (std::any_of(exclude.begin(), exclude.end(), [&](const cv::Rect& r) { return r.contains(p); })) continue;
       const int b = std::min(n_bins - 1, static_cast<int>((d - cfg.min_depth_m) / cfg.bin_m));
-      ++hist[static_cast<std::size_t>(b) + 1];
-      ++total;
+      ++h.bins[static_cast<std::size_t>(b) + 1];
+      ++h.total;
     }
   }
-  if (total == 0) return 0.0f;
+  return h;
+}
 
+// The nearest strong mode of the histogram (the person in front of the background), else the global mode.
+float person_depth_from(const DepthHistogram& h, const FilterConfig& cfg) {
+  if (h.total == 0) return 0.0f;
+  const int n_bins = static_cast<int>(h.bins.size()) - 2;
   // Counts over three neighbouring bins, so a surface straddling a bin edge still forms one peak.
   auto window = [&](int b) {
-    const auto i = static_cast<std::size_t>(b);  // hist[i + 1] is bin b
-    return hist[i] + hist[i + 1] + hist[i + 2];
+    const auto i = static_cast<std::size_t>(b);  // bins[i + 1] is bin b
+    return h.bins[i] + h.bins[i + 1] + h.bins[i + 2];
   };
-  const double strong = cfg.peak_fraction * total;
+  const double strong = cfg.peak_fraction * h.total;
   int peak = -1;
   for (int b = 0; b < n_bins; ++b) {
     if (window(b) < strong) continue;
@@ -72,11 +86,66 @@ float estimate_person_depth(const cv::Mat& depth_m, const cv::Rect& roi_in, cons
   // Count-weighted centre of the three bins around the peak.
   double sum = 0.0, count = 0.0;
   for (int b = std::max(0, peak - 1); b <= std::min(n_bins - 1, peak + 1); ++b) {
-    const int c = hist[static_cast<std::size_t>(b) + 1];
+    const int c = h.bins[static_cast<std::size_t>(b) + 1];
     sum += c * (cfg.min_depth_m + (b + 0.5) * cfg.bin_m);
     count += c;
   }
   return count > 0 ? static_cast<float>(sum / count) : 0.0f;
+}
+
+bool usable(const cv::Mat& depth_m, const FilterConfig& cfg) {
+  return !depth_m.empty() && depth_m.type() == CV_32FC1 && cfg.bin_m > 0.0f;
+}
+
+}  // namespace
+
+float estimate_person_depth(const cv::Mat& depth_m, const cv::Rect& roi_in, const std::vector<cv::Rect>& exclude,
+                            const FilterConfig& cfg) {
+  if (!usable(depth_m, cfg)) return 0.0f;
+  const cv::Rect roi = roi_in & cv::Rect(0, 0, depth_m.cols, depth_m.rows);
+  if (roi.area() <= 0) return 0.0f;
+  return person_depth_from(depth_histogram(depth_m, roi, exclude, cfg), cfg);
+}
+
+float estimate_person_depth(const cv::Mat& depth_m, const cv::Rect& roi, const FilterConfig& cfg) {
+  return estimate_person_depth(depth_m, roi, {}, cfg);
+}
+
+std::vector<PersonDepth> estimate_person_depths(const cv::Mat& depth_m, const std::vector<cv::Rect>& rects,
+                                                const FilterConfig& cfg) {
+  std::vector<PersonDepth> out(rects.size());
+  if (!usable(depth_m, cfg)) return out;
+  const cv::Rect image(0, 0, depth_m.cols, depth_m.rows);
+  for (std::size_t i = 0; i < rects.size(); ++i) {
+    const cv::Rect roi = rects[i] & image;
+    if (roi.area() <= 0) continue;
+    std::vector<cv::Rect> others;
+    for (std::size_t j = 0; j < rects.size(); ++j)
+      if (j != i && (rects[j] & roi).area() > 0) others.push_back(rects[j]);
+    const DepthHistogram whole = depth_histogram(depth_m, roi, {}, cfg);
+    out[i].whole_m = person_depth_from(whole, cfg);
+    if (others.empty()) continue;
+    const DepthHistogram own = depth_histogram(depth_m, roi, others, cfg);
+    if (own.total > 0 && own.total >= cfg.min_exclusive_share * whole.total) {
+      const float own_m = person_depth_from(own, cfg);
+      if (std::abs(own_m - out[i].whole_m) > cfg.depth_band_m) out[i].own_part_m = own_m;
+    }
+  }
+  return out;
+}
+
+cv::Mat distance_to_person(const cv::Mat& depth_m, const cv::Rect& roi, const PersonDepth& person,
+                           const FilterConfig& cfg) {
+  cv::Mat1b not_person(roi.size(), uchar(255));
+  for (int y = 0; y < roi.height; ++y) {
+    const float* d = depth_m.ptr<float>(roi.y + y) + roi.x;
+    uchar* m = not_person.ptr<uchar>(y);
+    for (int x = 0; x < roi.width; ++x)
+      if (valid_depth(d[x], cfg) && person.matches(d[x], cfg.depth_band_m)) m[x] = 0;
+  }
+  cv::Mat dist;
+  cv::distanceTransform(not_person, dist, cv::DIST_L2, 3);  // distance to the nearest zero (person) pixel
+  return dist;
 }
 
 std::vector<bool> filter_keypoints(const std::vector<cv::KeyPoint>& kps, const cv::Mat& depth_m,
@@ -91,18 +160,27 @@ std::vector<bool> filter_keypoints(const std::vector<cv::KeyPoint>& kps, const c
   const cv::Size size = has_depth ? depth_m.size() : cv::Size(INT_MAX / 2, INT_MAX / 2);
 
   std::vector<BoxDepth> bds;
-  bds.reserve(boxes.size());
+  std::vector<cv::Rect> rects;
   for (const auto& b : boxes) {
+    const cv::Rect r = enlarge_box(b.box, cfg.box_enlarge, size);
+    if (r.area() > 0) rects.push_back(r);
+  }
+  const std::vector<PersonDepth> person = has_depth ? estimate_person_depths(depth_m, rects, cfg)
+                                                    : std::vector<PersonDepth>(rects.size());
+  for (std::size_t k = 0; k < rects.size(); ++k) {
     BoxDepth bd;
-    bd.rect = enlarge_box(b.box, cfg.box_enlarge, size);
-    if (bd.rect.area() <= 0) continue;
-    bd.person_m = has_depth ? estimate_person_depth(depth_m, bd.rect, cfg) : 0.0f;
+    bd.rect = rects[k];
+    bd.person = person[k];
+    if (cfg.silhouette_margin_px > 0.0f && bd.person.whole_m > 0.0f)
+      bd.dist_to_person = distance_to_person(depth_m, bd.rect, bd.person, cfg);
     bds.push_back(bd);
   }
 
   for (std::size_t i = 0; i < kps.size(); ++i) {
     const cv::Point p(static_cast<int>(std::lround(kps[i].pt.x)), static_cast<int>(std::lround(kps[i].pt.y)));
-    bool inside = false, no_depth = false, at_person = false, behind = false, in_front = false;
+    bool inside = false, no_depth = false, at_person = false, behind = false, in_front = false, on_edge = false;
+    // Silhouette margin in pixels at this keypoint's scale (ORB sizes are 31 px times the level's scale).
+    const float margin = cfg.silhouette_margin_px * std::max(1.0f, kps[i].size / 31.0f);
     float d = 0.0f;
     bool d_valid = false;
     for (const auto& bd : bds) {
@@ -116,20 +194,21 @@ std::vector<bool> filter_keypoints(const std::vector<cv::KeyPoint>& kps, const c
       }
       if (!d_valid) {
         no_depth = true;
-      } else if (bd.person_m <= 0.0f || std::abs(d - bd.person_m) <= cfg.depth_band_m) {
+      } else if (bd.person.whole_m <= 0.0f || bd.person.matches(d, cfg.depth_band_m)) {
         at_person = true;  // an unknown person depth counts as "could be the person"
-      } else if (d > bd.person_m) {
-        behind = true;
       } else {
-        in_front = true;
+        if (d > bd.person.whole_m) behind = true;
+        else in_front = true;
+        if (!bd.dist_to_person.empty() && bd.dist_to_person.at<float>(p - bd.rect.tl()) <= margin) on_edge = true;
       }
     }
     if (!inside) continue;
     ++s.in_boxes;
-    if (no_depth || at_person) {
+    if (no_depth || at_person || on_edge) {
       keep[i] = false;
       ++s.dropped;
       if (no_depth) ++s.dropped_no_depth;
+      else if (!at_person) ++s.dropped_silhouette;
     } else if (behind) {
       ++s.kept_background;
     } else if (in_front) {

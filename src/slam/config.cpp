@@ -61,6 +61,9 @@ SlamConfig slam_config_from(const Settings& s) {
   c.tracking.kernel.type = optim::KernelType::Huber;
   read_kernel(s, "tracking", c.tracking.kernel);
   c.tracking.motion_radius = setting_or<double>(s, "tracking.motion_radius", c.tracking.motion_radius);
+  c.tracking.motion_inlier_ratio =
+      setting_or<double>(s, "tracking.motion_inlier_ratio", c.tracking.motion_inlier_ratio);
+  c.tracking.established_found = setting_or<int>(s, "tracking.established_found", c.tracking.established_found);
   c.tracking.min_inliers_local_map = setting_or<int>(s, "tracking.min_inliers", c.tracking.min_inliers_local_map);
   c.tracking.depth_edge_ratio = setting_or<double>(s, "depth.edge_ratio", c.tracking.depth_edge_ratio);
   c.tracking.close_keyframe_gap = setting_or<int>(s, "tracking.close_keyframe_gap", c.tracking.close_keyframe_gap);

@@ -12,6 +12,8 @@ struct TrackingConfig {
   optim::KernelConfig kernel;      // pose-only optimisation (ORB-SLAM3: Huber)
   double motion_radius = 15.0;     // search radius (pixels at level 0) when matching against the last frame
   int min_matches = 20;            // motion-model matches needed before optimising
+  double motion_inlier_ratio = 0.5;  // fewer motion-model inliers than this share of matches: cross-check
+  int established_found = 3;  // frames a point must have been an inlier in to anchor the first pose round (0: off)
   int min_inliers_local_map = 30;  // inliers after local-map tracking for the frame to count as tracked
   int max_local_keyframes = 80;
   int lost_frames_before_reinit = 3;  // failed recoveries before a new map segment starts

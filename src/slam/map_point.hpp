@@ -60,6 +60,7 @@ class MapPoint {
   // Tracking statistics (ratio found/visible drives culling).
   void increase_visible(int n = 1) { visible_.fetch_add(n); }
   void increase_found(int n = 1) { found_.fetch_add(n); }
+  int found() const { return found_.load(); }
   double found_ratio() const { return static_cast<double>(found_.load()) / std::max(1, visible_.load()); }
 
   // Per-frame scratch used by tracking only (tracking thread).

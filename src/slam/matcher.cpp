@@ -22,8 +22,9 @@ void enforce_rotation_consistency(Frame& cur, const std::vector<std::pair<int, f
   const std::vector<int> keep = rotation_consistent(diffs);
   std::vector<bool> kept(rot.size(), false);
   for (int k : keep) kept[k] = true;
+  // A keypoint can appear twice in `rot` (matched again by a later point): count each removal once.
   for (std::size_t i = 0; i < rot.size(); ++i)
-    if (!kept[i]) {
+    if (!kept[i] && cur.map_points[rot[i].first]) {
       cur.map_points[rot[i].first].reset();
       --n_matches;
     }

@@ -22,6 +22,7 @@ double ms_since(Clock::time_point t0) {
 
 constexpr int kMinKeypointsToInitialize = 500;  // enough structure to start a map (ORB-SLAM's rule)
 constexpr int kMinInliersMotion = 10;
+constexpr int kMinEstablished = 30;  // established matches needed to solve on them first
 
 }  // namespace
 
@@ -87,8 +88,7 @@ TrackOutcome Tracker::track(const RgbdFrame& input) {
   bool ok = false;
   if (state_ == TrackState::Ok) {
     refresh_last_frame();
-    if (has_velocity_) ok = track_motion_model(cur, out.timings);
-    if (!ok) ok = track_reference_keyframe(cur, reference_kf_, out.timings);
+    ok = track_initial_pose(cur, out.timings);
   } else {
     refresh_last_frame();
     ok = recover(cur, out.timings);
@@ -194,11 +194,23 @@ int Tracker::optimize_and_discard(Frame& cur, FrameTimings& t) {
     idx.push_back(static_cast<int>(i));
   }
   if (obs.size() < 3) return 0;
+  // Trust the established points first: when enough matches go to points already tracked as inliers in several
+  // frames, the first round solves on those alone and the others (temporary depth points, young map points) join
+  // only where they agree with that pose. A mover entering the view brings many young points that agree with
+  // each other (its own motion); solved on all at once, they can outvote the map.
+  std::vector<bool> young(idx.size(), false);
+  int established = 0;
+  for (std::size_t k = 0; k < idx.size(); ++k) {
+    const MapPointPtr& mp = cur.map_points[idx[k]];
+    young[k] = mp->num_observations() == 0 || mp->found() < cfg_.tracking.established_found;
+    established += !young[k];
+  }
+  const bool trust_established = cfg_.tracking.established_found > 0 && established >= kMinEstablished;
   optim::PoseOptimConfig pc;
   pc.kernel = cfg_.tracking.kernel;
   // The dedicated 6-DoF solver gives the same pose as Ceres (tested against it) at 1.5-2x less cost.
   pc.solver = optim::PoseSolver::Dedicated;
-  const auto res = optim::optimize_pose(camera_, cur.T_cw, pts, obs, pc);
+  const auto res = optim::optimize_pose(camera_, cur.T_cw, pts, obs, pc, trust_established ? &young : nullptr);
   cur.has_pose = true;
   int inliers = 0;
   for (std::size_t k = 0; k < idx.size(); ++k) {
@@ -209,7 +221,27 @@ int Tracker::optimize_and_discard(Frame& cur, FrameTimings& t) {
   return inliers;
 }
 
-bool Tracker::track_motion_model(Frame& cur, FrameTimings& t) {
+bool Tracker::track_initial_pose(Frame& cur, FrameTimings& t) {
+  if (!has_velocity_) return track_reference_keyframe(cur, reference_kf_, t) >= kMinInliersMotion;
+  int matches = 0;
+  const int inliers = track_motion_model(cur, t, &matches);
+  // Most motion-model matches rejected: the constant-velocity guess was off (a jerk of the hand-held camera) and
+  // the few surviving "inliers" may agree on a wrong pose. Try the reference keyframe from the last pose and keep
+  // whichever explains more matches.
+  const bool doubtful = inliers < kMinInliersMotion || inliers < cfg_.tracking.motion_inlier_ratio * matches;
+  if (!doubtful) return true;
+  Frame by_motion = cur;
+  const int by_keyframe = track_reference_keyframe(cur, reference_kf_, t);
+  if (by_keyframe >= kMinInliersMotion && by_keyframe >= inliers) {
+    spdlog::debug("frame {}: motion model doubtful ({} of {} matches), reference keyframe gives {} inliers", cur.id,
+                  inliers, matches, by_keyframe);
+    return true;
+  }
+  cur = std::move(by_motion);
+  return inliers >= kMinInliersMotion;
+}
+
+int Tracker::track_motion_model(Frame& cur, FrameTimings& t, int* matches) {
   auto t0 = Clock::now();
   cur.T_cw = velocity_ * last_.T_cw;
   std::fill(cur.map_points.begin(), cur.map_points.end(), nullptr);
@@ -219,7 +251,8 @@ bool Tracker::track_motion_model(Frame& cur, FrameTimings& t) {
     n = match_last_frame(cur, last_, 2 * cfg_.tracking.motion_radius);
   }
   t.match_ms += ms_since(t0);
-  if (n < cfg_.tracking.min_matches) return false;
+  *matches = n;
+  if (n < cfg_.tracking.min_matches) return 0;
   optimize_and_discard(cur, t);
   int inliers = 0;
   for (std::size_t i = 0; i < cur.map_points.size(); ++i) {
@@ -233,17 +266,17 @@ bool Tracker::track_motion_model(Frame& cur, FrameTimings& t) {
     }
   }
   cur.reference_kf = reference_kf_;
-  return inliers >= kMinInliersMotion;
+  return inliers;
 }
 
-bool Tracker::track_reference_keyframe(Frame& cur, const KeyFramePtr& kf, FrameTimings& t) {
-  if (!kf) return false;
+int Tracker::track_reference_keyframe(Frame& cur, const KeyFramePtr& kf, FrameTimings& t) {
+  if (!kf) return 0;
   auto t0 = Clock::now();
   cur.T_cw = last_.T_cw;
   std::fill(cur.map_points.begin(), cur.map_points.end(), nullptr);
   const int n = match_keyframe_by_descriptor(cur, *kf);
   t.match_ms += ms_since(t0);
-  if (n < 15) return false;
+  if (n < 15) return 0;
   optimize_and_discard(cur, t);
   int inliers = 0;
   for (std::size_t i = 0; i < cur.map_points.size(); ++i) {
@@ -256,7 +289,7 @@ bool Tracker::track_reference_keyframe(Frame& cur, const KeyFramePtr& kf, FrameT
     }
   }
   cur.reference_kf = kf;
-  return inliers >= kMinInliersMotion;
+  return inliers;
 }
 
 bool Tracker::recover(Frame& cur, FrameTimings& t) {
@@ -268,7 +301,7 @@ bool Tracker::recover(Frame& cur, FrameTimings& t) {
   for (const auto& kf : candidates) {
     if (kf->is_bad()) continue;
     last_.T_cw = predicted;
-    if (track_reference_keyframe(cur, kf, t)) {
+    if (track_reference_keyframe(cur, kf, t) >= kMinInliersMotion) {
       last_recovery_frame_id_ = cur.id;
       reference_kf_ = kf;
       spdlog::info("tracking recovered at t={:.3f} against keyframe {}", cur.timestamp, kf->id());

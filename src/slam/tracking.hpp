@@ -68,8 +68,11 @@ class Tracker {
   Frame build_frame(const RgbdFrame& input, FrameTimings& t);
   bool initialize(Frame& cur, const Eigen::Isometry3d& T_cw);
   void refresh_last_frame();
-  bool track_motion_model(Frame& cur, FrameTimings& t);
-  bool track_reference_keyframe(Frame& cur, const KeyFramePtr& kf, FrameTimings& t);
+  /// Motion model, falling back to (or cross-checked by) the reference keyframe; true when tracked.
+  bool track_initial_pose(Frame& cur, FrameTimings& t);
+  /// Both return the inliers after pose optimisation (0 when too few matches to optimise).
+  int track_motion_model(Frame& cur, FrameTimings& t, int* matches);
+  int track_reference_keyframe(Frame& cur, const KeyFramePtr& kf, FrameTimings& t);
   bool recover(Frame& cur, FrameTimings& t);
   bool track_local_map(Frame& cur, FrameTimings& t);
   int optimize_and_discard(Frame& cur, FrameTimings& t);

@@ -17,7 +17,18 @@ TEST(DetectorSettings, MissingSectionGivesDefaults) {
   const SemanticSettings ss = semantic_settings(from_yaml("fps: 30\n"));
   EXPECT_EQ(ss.detector.source, "none");
   EXPECT_FLOAT_EQ(ss.filter.depth_band_m, 0.5f);
+  EXPECT_FLOAT_EQ(ss.filter.silhouette_margin_px, 0.0f);
+  EXPECT_FLOAT_EQ(ss.filter.min_exclusive_share, 1.0f);
   EXPECT_TRUE(ss.asynchronous);
+}
+
+TEST(DetectorSettings, ReadsAndChecksTheOverlapAndSilhouetteKeys) {
+  const SemanticSettings ss =
+      semantic_settings(from_yaml("semantic:\n  silhouette_margin_px: 6\n  min_exclusive_share: 0.25\n"));
+  EXPECT_FLOAT_EQ(ss.filter.silhouette_margin_px, 6.0f);
+  EXPECT_FLOAT_EQ(ss.filter.min_exclusive_share, 0.25f);
+  EXPECT_THROW(semantic_settings(from_yaml("semantic:\n  silhouette_margin_px: -1\n")), ConfigError);
+  EXPECT_THROW(semantic_settings(from_yaml("semantic:\n  min_exclusive_share: 1.5\n")), ConfigError);
 }
 
 TEST(DetectorSettings, ReadsTheSemanticSection) {

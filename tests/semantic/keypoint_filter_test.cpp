@@ -127,5 +127,101 @@ TEST(KeypointFilter, EnlargeBoxClipsToTheImage) {
   EXPECT_EQ(enlarge_box({600, 450, 100, 100}, 0.1f, {640, 480}), cv::Rect(590, 440, 50, 40));
 }
 
+// Two people: a near one (1.2 m) whose box overlaps the left part of a farther one's box (2.3 m); wall at 4 m.
+struct TwoPeople {
+  cv::Mat depth{480, 640, CV_32FC1, cv::Scalar(4.0f)};
+  cv::Rect near_person{150, 60, 180, 400}, far_person{300, 150, 90, 250};
+  TwoPeople() {
+    depth(far_person).setTo(2.3f);
+    depth(near_person).setTo(1.2f);  // drawn last: it occludes the far person's left part
+  }
+  static Detection box(const cv::Rect& r) {
+    Detection d;
+    d.label = "person";
+    d.box = cv::Rect2f(r);
+    return d;
+  }
+  Detections boxes() const { return {box(near_person), box(far_person)}; }
+};
+
+FilterConfig exact_boxes(float share) {
+  FilterConfig cfg;
+  cfg.box_enlarge = 0.0f;
+  cfg.min_exclusive_share = share;
+  return cfg;
+}
+
+TEST(KeypointFilter, OverlappingNearerPersonCapturesTheWholeBoxEstimateButNotTheOwnPartOne) {
+  const TwoPeople s;
+  const std::vector<cv::Rect> rects = {s.near_person, s.far_person};
+  const auto on = estimate_person_depths(s.depth, rects, exact_boxes(0.2f));
+  ASSERT_EQ(on.size(), 2u);
+  EXPECT_NEAR(on[0].whole_m, 1.2f, 0.06f);
+  EXPECT_EQ(on[0].own_part_m, 0.0f);          // its own part says the same: no second depth
+  EXPECT_NEAR(on[1].whole_m, 1.2f, 0.06f);    // the near person's part is the nearest strong mode
+  EXPECT_NEAR(on[1].own_part_m, 2.3f, 0.06f);  // the part only this box covers finds the far person
+  const auto off = estimate_person_depths(s.depth, rects, exact_boxes(1.0f));
+  EXPECT_EQ(off[1].own_part_m, 0.0f);
+  EXPECT_NEAR(off[1].whole_m, 1.2f, 0.06f);
+}
+
+TEST(KeypointFilter, FarPersonBehindAnOverlappingNearOneIsDroppedWithTheOwnPartDepth) {
+  const TwoPeople s;
+  const std::vector<cv::KeyPoint> kps = {kp(360, 250), kp(200, 250), kp(500, 250)};  // far person, near, wall outside
+  const auto off = filter_keypoints(kps, s.depth, s.boxes(), exact_boxes(1.0f));
+  EXPECT_EQ(off, (std::vector<bool>{true, false, true}));  // the leak: far person counted as background
+  const auto on = filter_keypoints(kps, s.depth, s.boxes(), exact_boxes(0.2f));
+  EXPECT_EQ(on, (std::vector<bool>{false, false, true}));
+}
+
+TEST(KeypointFilter, OwnPartEstimateNeedsEnoughOfTheBoxLeft) {
+  TwoPeople s;
+  s.far_person = cv::Rect(160, 100, 200, 250);  // almost all of it inside the near person's box
+  s.depth = cv::Mat(480, 640, CV_32FC1, cv::Scalar(4.0f));
+  s.depth(s.far_person).setTo(2.3f);
+  s.depth(s.near_person).setTo(1.2f);
+  const auto d = estimate_person_depths(s.depth, {s.near_person, s.far_person}, exact_boxes(0.2f));
+  EXPECT_EQ(d[1].own_part_m, 0.0f);  // 30 of 200 columns left: below 20 % of the samples
+}
+
+// Person at 1.5 m filling x in [300, 340) of its box, wall at 4 m around it.
+struct Silhouette {
+  cv::Mat depth{480, 640, CV_32FC1, cv::Scalar(4.0f)};
+  Silhouette() { depth(cv::Rect(300, 100, 40, 300)).setTo(1.5f); }
+  Detections boxes() const {
+    Detection d;
+    d.label = "person";
+    d.box = cv::Rect2f(260, 80, 120, 340);
+    return {d};
+  }
+};
+
+TEST(KeypointFilter, SilhouetteMarginDropsWallKeypointsNextToThePersonOnly) {
+  const Silhouette s;
+  // Wall 3 px left of the person, wall 20 px left, person; a coarse keypoint (size 62 = level with scale 2) 8 px off.
+  const std::vector<cv::KeyPoint> kps = {kp(296, 200), kp(279, 200), kp(320, 200), cv::KeyPoint(348, 250, 62.f)};
+  FilterConfig cfg;
+  cfg.silhouette_margin_px = 0.0f;
+  EXPECT_EQ(filter_keypoints(kps, s.depth, s.boxes(), cfg), (std::vector<bool>{true, true, false, true}));
+  cfg.silhouette_margin_px = 5.0f;
+  FilterStats stats;
+  EXPECT_EQ(filter_keypoints(kps, s.depth, s.boxes(), cfg, &stats), (std::vector<bool>{false, true, false, false}));
+  EXPECT_EQ(stats.dropped, 3);
+  EXPECT_EQ(stats.dropped_silhouette, 2);
+  EXPECT_EQ(stats.kept_background, 1);
+}
+
+TEST(KeypointFilter, DistanceToPersonIsZeroOnThePersonAndGrowsAway) {
+  const Silhouette s;
+  PersonDepth p;
+  p.whole_m = 1.5f;
+  const cv::Rect roi(260, 80, 120, 340);
+  const cv::Mat dist = distance_to_person(s.depth, roi, p, FilterConfig{});
+  ASSERT_EQ(dist.size(), roi.size());
+  EXPECT_EQ(dist.at<float>(120, 60), 0.0f);               // (320, 200): on the person
+  EXPECT_NEAR(dist.at<float>(120, 36), 4.0f, 0.5f);       // (296, 200): 4 px left of x = 300
+  EXPECT_GT(dist.at<float>(120, 5), 20.0f);               // (265, 200)
+}
+
 }  // namespace
 }  // namespace varslam::semantic

@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <unistd.h>
@@ -52,9 +53,11 @@ const fs::path& static_sequence() {
   return dir;
 }
 
-RunSummary run_on(const fs::path& data, const fs::path& out, RunMode mode, std::size_t max_frames = SIZE_MAX) {
+RunSummary run_on(const fs::path& data, const fs::path& out, RunMode mode, std::size_t max_frames = SIZE_MAX,
+                  const std::function<void(SlamConfig&)>& adjust = {}) {
   Settings settings = settings_for_dataset(data, std::nullopt);
-  const SlamConfig cfg = slam_config_from(settings);
+  SlamConfig cfg = slam_config_from(settings);
+  if (adjust) adjust(cfg);
   auto ds = open_dataset(data, settings);
   RunOptions ro;
   ro.mode = mode;
@@ -90,6 +93,35 @@ TEST(EndToEnd, RealTimeModeTracksTheSameSequence) {
   EXPECT_EQ(s.tracked, s.frames);
   ASSERT_TRUE(s.ate_rmse.has_value());
   EXPECT_LT(*s.ate_rmse, 0.03);
+}
+
+// A real hand-held path with jitter (Bonn crowd3, 13.5-15.5 s): the camera turns by ~2 degrees between frames,
+// then back, so the constant-velocity guess is off by twice that. Near the end of this window the motion model
+// keeps few of its matches, agreeing on a pose a metre away; without the reference-keyframe cross-check
+// (tracking.motion_inlier_ratio = 0) this run ends with an ATE RMSE of 47 cm instead of 0.5 cm.
+TEST(EndToEnd, JerkyHandHeldPathIsTracked) {
+  const fs::path path = fs::path(VARSLAM_SHARED_DIR) / "trajectories" / "rgbd_bonn_crowd3";
+  if (!fs::exists(path)) GTEST_SKIP() << "camera paths not found at " << path << " (../shared is absent)";
+  const fs::path seq = fs::temp_directory_path() / "varslam_e2e_jerky_seq_v1";
+  if (!fs::exists(seq / "groundtruth.txt")) {
+    const fs::path tmp = fs::temp_directory_path() / ("varslam_e2e_jerky_tmp_" + std::to_string(::getpid()));
+    fs::remove_all(tmp);
+    synth::SynthConfig cfg;
+    cfg.scenario = "static";
+    cfg.seconds = 2.0;
+    cfg.seed = 2;
+    cfg.path_file = path;
+    cfg.path_start = 13.5;
+    cfg.preview = false;
+    synth::generate(cfg, tmp);
+    std::error_code ec;
+    fs::rename(tmp, seq, ec);
+    if (ec) fs::remove_all(tmp);
+  }
+  const RunSummary s = run_on(seq, test_dir("jerky"), RunMode::Deterministic);
+  EXPECT_EQ(s.tracked, s.frames);
+  ASSERT_TRUE(s.ate_rmse.has_value());
+  EXPECT_LT(*s.ate_rmse, 0.02) << "ATE RMSE " << *s.ate_rmse << " m";
 }
 
 TEST(EndToEnd, RealKitchenExcerpt) {
