@@ -17,6 +17,7 @@ void add_synth_command(CLI::App& app) {
     std::string path;
     bool list = false;
     bool no_preview = false;
+    bool hide_movers = false;
   };
   auto opt = std::make_shared<Options>();
   cmd->add_option("--scenario", opt->cfg.scenario, "static | walking | unknown_box | obstructing_box | balloon | mixed")
@@ -29,6 +30,8 @@ void add_synth_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--out", opt->out, "Output folder (default: synth_<scenario>_<seed>)");
   cmd->add_flag("--no-preview", opt->no_preview, "Do not write preview.png");
+  cmd->add_flag("--hide-movers", opt->hide_movers,
+                "Debug: render the scenario's world without its movers (identical to 'static')");
   cmd->add_option("--box-miss", opt->cfg.box_miss_rate, "Share of person boxes left out, like detector misses")
       ->capture_default_str();
   cmd->add_option("--box-jitter", opt->cfg.box_jitter_px, "Gaussian jitter of person box edges in pixels")
@@ -42,6 +45,7 @@ void add_synth_command(CLI::App& app) {
     synth::SynthConfig cfg = opt->cfg;
     cfg.path_file = opt->path;
     cfg.preview = !opt->no_preview;
+    cfg.render_movers = !opt->hide_movers;
     const std::filesystem::path out =
         opt->out.empty() ? std::filesystem::path(fmt::format("synth_{}_{}", cfg.scenario, cfg.seed)) : std::filesystem::path(opt->out);
     cfg.progress = [](std::size_t done, std::size_t total) {

@@ -1,6 +1,7 @@
 #include "io/depth_image.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <stdexcept>
 #include <vector>
@@ -36,6 +37,34 @@ double median_valid_depth(const cv::Mat& metres, int step) {
   auto mid = valid.begin() + static_cast<std::ptrdiff_t>(valid.size() / 2);
   std::nth_element(valid.begin(), mid, valid.end());
   return *mid;
+}
+
+}  // namespace varslam
+
+namespace varslam {
+
+cv::Mat register_depth_to_colour(const cv::Mat& depth_m, const DepthCameraRig& rig, const PinholeCamera& colour) {
+  CV_Assert(depth_m.type() == CV_32FC1);
+  cv::Mat out(colour.height, colour.width, CV_32FC1, cv::Scalar(0.0f));
+  const PinholeCamera& d = rig.depth;
+  const Eigen::Vector3d& t = rig.t_colour_depth;
+  for (int v = 0; v < depth_m.rows; ++v) {
+    const auto* row = depth_m.ptr<float>(v);
+    for (int u = 0; u < depth_m.cols; ++u) {
+      const float z = row[u];
+      if (!(z > 0.0f)) continue;
+      const Eigen::Vector3d p = d.unproject(u, v, z) + t;
+      if (p.z() <= 0.0) continue;
+      const Eigen::Vector2d uv = colour.project(p);
+      const int cu = static_cast<int>(std::lround(uv.x()));
+      const int cv_ = static_cast<int>(std::lround(uv.y()));
+      if (cu < 0 || cv_ < 0 || cu >= out.cols || cv_ >= out.rows) continue;
+      float& dst = out.at<float>(cv_, cu);
+      const auto zc = static_cast<float>(p.z());
+      if (dst == 0.0f || zc < dst) dst = zc;  // z-buffer: the nearer surface occludes the farther one
+    }
+  }
+  return out;
 }
 
 }  // namespace varslam

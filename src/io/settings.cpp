@@ -225,13 +225,19 @@ Settings default_settings() {
 }
 
 Settings load_settings(const std::filesystem::path& file) {
-  Settings s = default_settings();
-  s.source = file;
+  YAML::Node root;
   try {
-    s.root = YAML::Load(read_yaml_text(file));
+    root = YAML::Load(read_yaml_text(file));
   } catch (const YAML::Exception& e) {
     throw ConfigError(fmt::format("{}:{}: not valid YAML: {}", file.string(), e.mark.line + 1, e.msg));
   }
+  return settings_from_yaml(root, file);
+}
+
+Settings settings_from_yaml(const YAML::Node& root, const std::filesystem::path& file) {
+  Settings s = default_settings();
+  s.source = file;
+  s.root = root;
   if (!s.root.IsMap())
     throw ConfigError(fmt::format("{}: expected a YAML map of settings at the top level", file.string()));
 

@@ -34,6 +34,9 @@ struct Settings {
 Settings default_settings();
 /// Load a settings file; throws ConfigError naming the file and key on a missing or malformed value.
 Settings load_settings(const std::filesystem::path& file);
+/// The same from a parsed document (`file` names it in errors): re-reads camera, depth and ORB fields after
+/// `--set` overrides edited the document.
+Settings settings_from_yaml(const YAML::Node& root, const std::filesystem::path& file);
 /// Write our own YAML layout (what `synth` puts next to a generated sequence).
 void save_settings(const Settings& s, const std::filesystem::path& file);
 

@@ -2,10 +2,13 @@
 
 #include <algorithm>
 #include <chrono>
+#include <functional>
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
+#include <ceres/iteration_callback.h>
 #include <ceres/ordered_groups.h>
 #include <ceres/problem.h>
 #include <ceres/solver.h>
@@ -124,9 +127,48 @@ class BaState {
   std::vector<int> pose_uses_, point_uses_;     // active observations per parameter block
 };
 
+/// The alternation's alpha refits as checkpoints inside a Ceres solve (BarronAdaptive). Checkpoint k sits at
+/// phase-1 iteration k * `every`, as in the fixed schedule "fit, solve `every` iterations"; a refit that leaves
+/// alpha unchanged lets the solve go on, so only a moved alpha pays for a new solve (Ceres' preprocessing and
+/// a fresh trust region). Needs Solver::Options::update_state_every_iteration (the refit reads the state).
+class AlphaCheckpoints final : public ceres::IterationCallback {
+ public:
+  /// `refit` fits alpha on the current state, logs and applies it, and says whether alpha changed.
+  AlphaCheckpoints(int every, int count, std::function<bool()> refit)
+      : every_(every), count_(count), refit_(std::move(refit)) {}
+
+  /// Before each solve: phase-1 iterations already run, on the fixed schedule's clock.
+  void start_solve(int iterations_before) {
+    offset_ = iterations_before;
+    alpha_moved_ = false;
+  }
+  /// Takes the next checkpoint now (the solve stopped before reaching it); its iteration on the clock.
+  int take_next() {
+    alpha_moved_ = refit_();
+    return every_ * reached_++;
+  }
+  int reached() const { return reached_; }
+  bool alpha_moved() const { return alpha_moved_; }  // the last solve stopped because a refit moved alpha
+
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
+    if (s.iteration == 0 || reached_ >= count_ || offset_ + s.iteration != every_ * reached_)
+      return ceres::SOLVER_CONTINUE;
+    take_next();
+    return alpha_moved_ ? ceres::SOLVER_TERMINATE_SUCCESSFULLY : ceres::SOLVER_CONTINUE;
+  }
+
+ private:
+  int every_, count_;
+  std::function<bool()> refit_;
+  int reached_ = 1;  // checkpoint 0 precedes the first solve
+  int offset_ = 0;
+  bool alpha_moved_ = false;
+};
+
 }  // namespace
 
 BaResult solve_local_ba(const PinholeCamera& cam, BaProblem& problem, const BaConfig& cfg) {
+  if (cfg.observer) cfg.observer(cam, problem, cfg);
   const auto start = std::chrono::steady_clock::now();
   const KernelConfig& kernel = cfg.kernel;
   const bool adaptive = kernel.type == KernelType::BarronAdaptive;
@@ -165,30 +207,47 @@ BaResult solve_local_ba(const PinholeCamera& cam, BaProblem& problem, const BaCo
   bool converged = false;
   double solved_alpha = alpha;
   auto solve = [&](ceres::Problem& ceres_problem, int iterations) {
-    if (iterations <= 0 || ceres_problem.NumResidualBlocks() == 0) return;
-    if (converged && alpha == solved_alpha) return;
+    if (iterations <= 0 || ceres_problem.NumResidualBlocks() == 0) return 0;
+    if (converged && alpha == solved_alpha) return 0;
+    solved_alpha = alpha;  // before the solve: a checkpoint inside it may change alpha
     options.max_num_iterations = iterations;
     ceres::Solver::Summary summary;
     ceres::Solve(options, &ceres_problem, &summary);
-    result.solver_iterations += static_cast<int>(summary.iterations.size()) - 1;
+    const int ran = static_cast<int>(summary.iterations.size()) - 1;
+    result.solver_iterations += ran;
+    ++result.solves;
     converged = summary.termination_type == ceres::CONVERGENCE;
-    solved_alpha = alpha;
+    return ran;
   };
 
-  // Phase 1: every observation; adaptive alpha alternates with short solves on the same problem (the losses
-  // are re-evaluated by every solver iteration, so changing their alpha between solves is all it takes).
+  // Phase 1: every observation; adaptive alpha alternates with the solver on the same problem (the losses are
+  // re-evaluated by every solver iteration, so changing their alpha between solves is all it takes).
   std::vector<bool> active(n, true);
   state.build(active);
   options.linear_solver_ordering = state.ordering();
   if (adaptive) {
-    for (int outer = 0; outer < cfg.outer_iterations; ++outer) {
-      if (outer > 0 || cfg.alpha_start != AlphaStart::SolveFirst) {
-        refit_alpha(active);
-      } else {
-        result.alpha_per_iteration.push_back(alpha);  // AlphaStart::SolveFirst: barron_alpha, no fit yet
-      }
-      solve(state.ceres_problem(), cfg.iterations);
+    if (cfg.alpha_start != AlphaStart::SolveFirst)
+      refit_alpha(active);
+    else
+      result.alpha_per_iteration.push_back(alpha);  // AlphaStart::SolveFirst: barron_alpha, no fit yet
+    AlphaCheckpoints checkpoints(cfg.iterations, cfg.outer_iterations, [&] {
+      const double before = alpha;
+      refit_alpha(active);
+      return alpha != before;
+    });
+    options.callbacks = {&checkpoints};
+    options.update_state_every_iteration = true;
+    const int budget = cfg.outer_iterations * cfg.iterations;
+    int clock = 0;  // phase-1 iterations on the fixed schedule's clock
+    while (clock < budget) {
+      checkpoints.start_solve(clock);
+      clock += solve(state.ceres_problem(), budget - clock);
+      if (checkpoints.alpha_moved()) continue;                 // go on with the new alpha
+      if (checkpoints.reached() >= cfg.outer_iterations) break;  // Ceres stopped after the last checkpoint
+      clock = checkpoints.take_next();  // Ceres stopped early: refit on its final state, as the fixed schedule
     }
+    options.callbacks.clear();
+    options.update_state_every_iteration = false;
   } else {
     solve(state.ceres_problem(), cfg.outer_iterations * cfg.iterations);
   }

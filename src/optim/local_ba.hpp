@@ -1,5 +1,6 @@
 #pragma once
 // Local Bundle Adjustment for local mapping on plain data: keyframe poses T_cw, world points, observations.
+#include <functional>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -38,6 +39,11 @@ enum class AlphaStart {
   SolveFirst,
 };
 
+struct BaConfig;
+/// Sees a problem before solve_local_ba solves it (bench/kernel_cost_bench records the Local BA problems of a
+/// real run to replay them under other kernels). Called from the solving thread.
+using LocalBaObserver = std::function<void(const PinholeCamera&, const BaProblem&, const BaConfig&)>;
+
 struct BaConfig {
   KernelConfig kernel;
   AlphaStart alpha_start = AlphaStart::FitInitialState;
@@ -46,6 +52,7 @@ struct BaConfig {
   int refine_iterations = 10;  // second phase, after the outlier gate
   bool remove_outliers = true;
   int max_threads = 1;
+  LocalBaObserver observer;  // empty: none
 };
 
 struct BaResult {
@@ -58,17 +65,21 @@ struct BaResult {
   // and at the final state (plain least squares, so comparable whatever kernel and alpha were used).
   double initial_cost = 0, final_cost = 0;
   int solver_iterations = 0;  // total over all Ceres solves
+  int solves = 0;             // Ceres solves run (each one preprocesses the problem again)
 };
 
 /// Local BA: optimise non-fixed keyframes and all points in place. ORB-SLAM-style schedule: solve, then mark
 /// observations failing the chi2 test (or with non-positive depth) as outliers, solve again without them.
 /// Fixed kernels solve the first phase in one go; BarronAdaptive alternates: each outer iteration estimates
 /// alpha on the current active whitened residuals (fixed state), then runs `iterations` solver iterations with
-/// that alpha; the refine phase fits alpha once more on the surviving observations. The Ceres problem is built
-/// once: alpha changes only touch the loss objects, and the refine phase removes the outlier residual blocks.
+/// that alpha; the refine phase fits alpha once more on the surviving observations. The refits are checkpoints
+/// inside one Ceres solve (every `iterations` iterations): only a refit that moves alpha ends the solve and
+/// starts a new one, so an alpha that holds costs no extra preprocessing (BaResult::solves). The Ceres problem
+/// is built once: alpha changes only touch the loss objects, and the refine phase removes the outlier blocks.
 /// With kernel.chi2_gates = false only observations behind the camera are gated. Ceres SPARSE_SCHUR with
 /// points eliminated first, PoseManifold on the poses, deterministic with max_threads = 1.
 /// Throws std::invalid_argument on an observation indexing a missing keyframe or point.
 BaResult solve_local_ba(const PinholeCamera& cam, BaProblem& problem, const BaConfig& cfg);
+
 
 }  // namespace varslam::optim

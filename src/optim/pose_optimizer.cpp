@@ -4,6 +4,7 @@
 #include <chrono>
 #include <memory>
 #include <stdexcept>
+#include <utility>
 
 #include <ceres/problem.h>
 #include <ceres/solver.h>
@@ -65,14 +66,15 @@ double linearize(const PinholeCamera& cam, const Eigen::Isometry3d& T, const std
 /// Steps start on the IRLS Hessian (robust far from the optimum) unless `start_newton`, and switch to the full
 /// Gauss-Newton Hessian once an accepted step changed the cost by under 1%: IRLS alone converges only linearly
 /// on smooth kernels (Barron alpha = 1 needed ~2x the iterations of Huber, whose inliers are purely
-/// quadratic). A rejected full step falls back to IRLS before any extra damping.
-void solve_dedicated(const PinholeCamera& cam, Eigen::Isometry3d& T, const std::vector<Eigen::Vector3d>& points,
-                     const std::vector<Observation>& obs, const std::vector<bool>& active, const Kernel& kernel,
-                     int iterations, bool start_newton) {
+/// quadratic). A rejected full step falls back to IRLS before any extra damping. Returns the trial steps taken.
+int solve_dedicated(const PinholeCamera& cam, Eigen::Isometry3d& T, const std::vector<Eigen::Vector3d>& points,
+                    const std::vector<Observation>& obs, const std::vector<bool>& active, const Kernel& kernel,
+                    int iterations, bool start_newton) {
   NormalEquations ne, ne_new;
   double cost = linearize(cam, T, points, obs, active, kernel, &ne);
   double lambda = 1e-4;
   bool newton = start_newton;
+  int steps = 0;
   for (int it = 0; it < iterations; ++it) {
     const Matrix6d H = ne.H(newton);
     Matrix6d A = H;
@@ -81,6 +83,7 @@ void solve_dedicated(const PinholeCamera& cam, Eigen::Isometry3d& T, const std::
     if (!delta.allFinite()) break;
     const Eigen::Isometry3d T_new = se3_left_update(T, delta);
     const double cost_new = linearize(cam, T_new, points, obs, active, kernel, &ne_new);
+    ++steps;
     if (cost_new < cost) {
       // Same stopping rule as Ceres' default function_tolerance, so both solvers do comparable work.
       const bool converged = delta.squaredNorm() < 1e-20 || cost - cost_new < 1e-6 * cost;
@@ -98,6 +101,7 @@ void solve_dedicated(const PinholeCamera& cam, Eigen::Isometry3d& T, const std::
     }
   }
   T = normalized(T);
+  return steps;
 }
 
 /// The same problem on Ceres: kept to measure against (and as a reference in tests).
@@ -119,8 +123,9 @@ class CeresPoseSolver {
     options_.minimizer_progress_to_stdout = false;
   }
 
-  void solve(Eigen::Isometry3d& T, const std::vector<Observation>& obs, const std::vector<bool>& active,
-             double alpha, int iterations) {
+  /// Returns Ceres' iteration count.
+  int solve(Eigen::Isometry3d& T, const std::vector<Observation>& obs, const std::vector<bool>& active,
+            double alpha, int iterations) {
     if (mono_loss_) mono_loss_->set_alpha(alpha);
     if (stereo_loss_) stereo_loss_->set_alpha(alpha);
     ceres::Problem::Options po;
@@ -139,6 +144,7 @@ class CeresPoseSolver {
     ceres::Solver::Summary summary;
     ceres::Solve(options_, &problem, &summary);
     T = params_to_pose(x);
+    return static_cast<int>(summary.iterations.size()) - 1;
   }
 
  private:
@@ -153,6 +159,7 @@ class CeresPoseSolver {
 PoseOptimResult optimize_pose(const PinholeCamera& cam, Eigen::Isometry3d& T_cw,
                               const std::vector<Eigen::Vector3d>& points_w, const std::vector<Observation>& obs,
                               const PoseOptimConfig& cfg, const std::vector<bool>* initial_outliers) {
+  if (cfg.observer) cfg.observer(cam, T_cw, points_w, obs, cfg, initial_outliers);
   const auto start = std::chrono::steady_clock::now();
   if (points_w.size() != obs.size())
     throw std::invalid_argument("optimize_pose: points_w and obs differ in size");
@@ -191,9 +198,10 @@ PoseOptimResult optimize_pose(const PinholeCamera& cam, Eigen::Isometry3d& T_cw,
       alpha = fit_alpha(kernel, samples.samples(), alpha);
     }
     if (ceres_solver)
-      ceres_solver->solve(T_cw, obs, active, alpha, cfg.iterations_per_round);
+      result.iterations += ceres_solver->solve(T_cw, obs, active, alpha, cfg.iterations_per_round);
     else
-      solve_dedicated(cam, T_cw, points_w, obs, active, Kernel(kernel, alpha), cfg.iterations_per_round, round > 0);
+      result.iterations += solve_dedicated(cam, T_cw, points_w, obs, active, Kernel(kernel, alpha),
+                                           cfg.iterations_per_round, round > 0);
 
     // Re-classify every observation (inactive ones too: they can come back).
     for (std::size_t i = 0; i < n; ++i) {

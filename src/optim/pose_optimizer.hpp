@@ -1,6 +1,7 @@
 #pragma once
 // Pose-only optimisation for tracking: refine T_cw from fixed world points and their observations, with
 // ORB-SLAM's round schedule (optimise, re-classify outliers by chi2, optimise again without them).
+#include <functional>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -22,11 +23,20 @@ enum class PoseSolver {
   Ceres,      // ceres::Problem per round, PoseManifold, DENSE_NORMAL_CHOLESKY
 };
 
+struct PoseOptimConfig;
+/// Sees a problem before optimize_pose solves it (bench/kernel_cost_bench records the tracking problems of a
+/// real run to replay them under other kernels). Called from the optimising thread.
+using PoseProblemObserver =
+    std::function<void(const PinholeCamera&, const Eigen::Isometry3d& T_cw, const std::vector<Eigen::Vector3d>& points_w,
+                       const std::vector<Observation>& obs, const PoseOptimConfig& cfg,
+                       const std::vector<bool>* initial_outliers)>;
+
 struct PoseOptimConfig {
   KernelConfig kernel;
   int rounds = 4;
   int iterations_per_round = 10;
   PoseSolver solver = PoseSolver::Ceres;
+  PoseProblemObserver observer;  // empty: none
 };
 
 struct PoseOptimResult {
@@ -34,6 +44,7 @@ struct PoseOptimResult {
   std::vector<bool> outlier;  // per observation, after the last round
   double seconds = 0;
   double alpha = 2.0;         // kernel alpha used in the last round (Barron kernels; 2 otherwise)
+  int iterations = 0;         // solver iterations over all rounds (Dedicated: trial steps; Ceres: its iterations)
 };
 
 /// Refines T_cw from 3-D world points and their observations; outliers re-classified each round by chi2

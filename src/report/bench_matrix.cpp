@@ -8,6 +8,7 @@
 
 #include "core/error.hpp"
 #include "io/trajectory_io.hpp"
+#include "synth/synth.hpp"
 
 namespace varslam::report {
 namespace fs = std::filesystem;
@@ -146,6 +147,8 @@ std::string synth_cache_key(const SequenceSpec& seq) {
   k << "scenario=" << seq.scenario << "\npath=" << fs::absolute(seq.path_file).lexically_normal().string()
     << "\npath_start=" << fmt::format("{}", seq.path_start) << "\nseed=" << seq.seed
     << "\nseconds=" << fmt::format("{}", seq.seconds) << "\n";
+  // Cached sequences of an older generator are regenerated (synth::kGeneratorVersion).
+  k << "generator=" << synth::kGeneratorVersion << "\n";
   return k.str();
 }
 

@@ -43,6 +43,26 @@ void read_kernel(const Settings& s, const std::string& section, optim::KernelCon
     throw ConfigError(fmt::format("{}: {}.barron_c and {}.tau must be positive", s.source.string(), section, section));
 }
 
+// The depth camera's intrinsics and its origin in the colour frame; absent (registered depth) without
+// depth.camera_fx. Its image size is the colour camera's (both 640x480 on a Kinect).
+std::optional<DepthCameraRig> read_depth_rig(const Settings& s) {
+  if (setting_or<double>(s, "depth.camera_fx", 0.0) == 0.0) return std::nullopt;
+  DepthCameraRig rig;
+  PinholeCamera& d = rig.depth;
+  d.width = s.camera.width;
+  d.height = s.camera.height;
+  d.fx = setting_or<double>(s, "depth.camera_fx", 0.0);
+  d.fy = setting_or<double>(s, "depth.camera_fy", d.fx);
+  d.cx = setting_or<double>(s, "depth.camera_cx", s.camera.cx);
+  d.cy = setting_or<double>(s, "depth.camera_cy", s.camera.cy);
+  rig.t_colour_depth = {setting_or<double>(s, "depth.camera_tx", 0.0), setting_or<double>(s, "depth.camera_ty", 0.0),
+                        setting_or<double>(s, "depth.camera_tz", 0.0)};
+  if (!(d.fx > 0 && d.fy > 0) || !rig.t_colour_depth.allFinite())
+    throw ConfigError(fmt::format("{}: depth.camera_fx and depth.camera_fy must be > 0 and depth.camera_t* finite",
+                                  s.source.string()));
+  return rig;
+}
+
 }  // namespace
 
 SlamConfig slam_config_from(const Settings& s) {
@@ -66,6 +86,8 @@ SlamConfig slam_config_from(const Settings& s) {
   c.tracking.established_found = setting_or<int>(s, "tracking.established_found", c.tracking.established_found);
   c.tracking.min_inliers_local_map = setting_or<int>(s, "tracking.min_inliers", c.tracking.min_inliers_local_map);
   c.tracking.depth_edge_ratio = setting_or<double>(s, "depth.edge_ratio", c.tracking.depth_edge_ratio);
+  c.tracking.depth_rig = read_depth_rig(s);
+  c.tracking.vo_points = setting_or<int>(s, "tracking.vo_points", c.tracking.vo_points);
   c.tracking.close_keyframe_gap = setting_or<int>(s, "tracking.close_keyframe_gap", c.tracking.close_keyframe_gap);
   c.tracking.lost_frames_before_reinit =
       setting_or<int>(s, "tracking.lost_frames_before_reinit", c.tracking.lost_frames_before_reinit);

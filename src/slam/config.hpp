@@ -1,10 +1,14 @@
 #pragma once
 // Everything the SLAM stages need to know, read once from the settings file.
+#include <optional>
 #include <string>
 
 #include "features/feature_extractor.hpp"
+#include "io/depth_image.hpp"
 #include "io/settings.hpp"
 #include "optim/kernel.hpp"
+#include "optim/local_ba.hpp"
+#include "optim/pose_optimizer.hpp"
 
 namespace varslam::slam {
 
@@ -20,6 +24,10 @@ struct TrackingConfig {
   int vo_points = 100;             // temporary depth points in the last frame (RGB-D visual odometry)
   int close_keyframe_gap = 5;      // frames between keyframes triggered by untracked close points
   double depth_edge_ratio = 0.1;   // > 0: drop the depth of keypoints on depth discontinuities (see frame.hpp)
+  // Set when depth comes from a separate, unregistered camera (raw Kinect v1, 7-Scenes): the depth image is
+  // warped into the colour camera before keypoint depths are read (keys depth.camera_fx/fy/cx/cy/tx/ty/tz).
+  std::optional<DepthCameraRig> depth_rig;
+  optim::PoseProblemObserver pose_observer;  // debug/benchmark hook: sees every pose problem (empty: none)
 };
 
 struct MappingConfig {
@@ -31,6 +39,7 @@ struct MappingConfig {
   int max_ba_keyframes = 20;  // optimised keyframes per Local BA (the most covisible); others observing stay fixed
   double keyframe_redundancy = 0.9;  // share of points seen by >= 3 other keyframes that makes a keyframe redundant
   bool cull_keyframes = true;
+  optim::LocalBaObserver ba_observer;  // debug/benchmark hook: sees every Local BA problem (empty: none)
 };
 
 struct SlamConfig {

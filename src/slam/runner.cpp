@@ -110,6 +110,9 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const Slam
     std::optional<RgbdFrame> frame = prefetch.next();
     const double load_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_load).count();
     if (!frame) break;
+    // Unregistered depth (separate depth camera): warp it into the colour camera before any stage reads it.
+    if (cfg.tracking.depth_rig)
+      frame->depth = register_depth_to_colour(frame->depth, *cfg.tracking.depth_rig, settings.camera);
     if (n == 0) first_stamp = frame->timestamp;
     if (options.mode == RunMode::RealTime && options.pace) {
       // Feed at the sensor's rate: wait until this frame's time has come.

@@ -210,6 +210,7 @@ int Tracker::optimize_and_discard(Frame& cur, FrameTimings& t) {
   pc.kernel = cfg_.tracking.kernel;
   // The dedicated 6-DoF solver gives the same pose as Ceres (tested against it) at 1.5-2x less cost.
   pc.solver = optim::PoseSolver::Dedicated;
+  pc.observer = cfg_.tracking.pose_observer;
   const auto res = optim::optimize_pose(camera_, cur.T_cw, pts, obs, pc, trust_established ? &young : nullptr);
   cur.has_pose = true;
   int inliers = 0;

@@ -115,16 +115,18 @@ FrameBoxes person_boxes(const cv::Mat1b& ids, std::size_t n_people, double ts, c
   return out;
 }
 
-// Mean image motion (pixels) during the exposure, from the poses at its start and end and the rendered depth.
-cv::Vec2d exposure_motion(const PinholeCamera& cam, const cv::Mat1f& depth, const Eigen::Isometry3d& T_wc,
+// Mean image motion (pixels) during the exposure, from the poses at its start and end and the rendered depth of
+// the static scene (sample points on a mover are skipped, so a mover does not change the blur of the whole image).
+cv::Vec2d exposure_motion(const PinholeCamera& cam, const RenderOutput& r, const Eigen::Isometry3d& T_wc,
                           const Eigen::Isometry3d& T_a, const Eigen::Isometry3d& T_b) {
   cv::Vec2d sum(0, 0);
   int n = 0;
   for (int j = 1; j <= 3; ++j)
     for (int i = 1; i <= 3; ++i) {
       const double u = cam.width * i / 4.0, v = cam.height * j / 4.0;
-      const double z = depth(static_cast<int>(v), static_cast<int>(u));
-      if (z <= 0) continue;
+      const int row = static_cast<int>(v), col = static_cast<int>(u);
+      const double z = r.depth(row, col);
+      if (z <= 0 || r.ids(row, col) != kStaticId) continue;
       const Eigen::Vector3d pw = T_wc * cam.unproject(u, v, z);
       const Eigen::Vector3d pa = T_a.inverse() * pw, pb = T_b.inverse() * pw;
       if (pa.z() <= 0.05 || pb.z() <= 0.05) continue;
@@ -184,7 +186,10 @@ SynthSummary generate(const SynthConfig& cfg, const std::filesystem::path& out_d
   const double floor_y = hi.y() + 1.35, ceiling_y = lo.y() - 1.4;
 
   const std::uint64_t seed = cfg.seed;
-  Movers movers = Movers::script(cfg.scenario, anchor, floor_y, span, pose_at, mix_seed(seed, 11));
+  // The room is laid out around the movers of every scenario, so it is the same for all of them (a function of
+  // path and seed only) and scenarios differ only in the movers shown.
+  const Movers all_movers = Movers::plan_all(anchor, floor_y, span, pose_at, mix_seed(seed, 11));
+  Movers movers = all_movers.select(cfg.scenario);
 
   Eigen::Vector3d room_lo = lo.array() - 1.5, room_hi = hi.array() + 1.5;
   auto enclose = [&](const Eigen::Vector3d& p, double margin) {
@@ -194,14 +199,14 @@ SynthSummary generate(const SynthConfig& cfg, const std::filesystem::path& out_d
   // Far wall about 4.6 m ahead: most of the view stays within the 5.5 m depth range, as in an office.
   enclose(anchor.center + 4.6 * anchor.forward + 3.0 * anchor.right, 0.0);
   enclose(anchor.center + 4.6 * anchor.forward - 3.0 * anchor.right, 0.0);
-  for (const auto& p : movers.extent_points()) enclose(p, 0.6);
+  for (const auto& p : all_movers.extent_points()) enclose(p, 0.6);
   room_lo.y() = ceiling_y;
   room_hi.y() = floor_y;
 
-  std::vector<KeepOut> keep = movers.keep_outs();
+  std::vector<KeepOut> keep = all_movers.keep_outs();
   for (std::size_t i = 0; i < n_frames; i += 5) keep.push_back({{poses[i].translation().x(), poses[i].translation().z()}, 0.6});
   Scene scene = build_static_scene(room_lo, room_hi, anchor, keep, mix_seed(seed, 22));
-  movers.add_materials(scene, mix_seed(seed, 33));
+  movers.add_materials(scene);
 
   prepare_dir(out_dir);
   PinholeCamera cam;  // fx = fy = 525, cx = 319.5, cy = 239.5, 640x480, bf = 40
@@ -244,12 +249,12 @@ SynthSummary generate(const SynthConfig& cfg, const std::filesystem::path& out_d
         const double t = static_cast<double>(i) / cfg.fps;
         SplitMix64 rng(mix_seed(seed, 1000 + i));
         dynamic.clear();
-        movers.primitives_at(t, dynamic);
+        if (cfg.render_movers) movers.primitives_at(t, dynamic);
         renderer.render(scene, dynamic, poses[i], r);
 
         if (cfg.motion_blur && cfg.exposure_s > 0) {
           const cv::Vec2d m =
-              exposure_motion(cam, r.depth, poses[i], pose_at(t - cfg.exposure_s / 2), pose_at(t + cfg.exposure_s / 2));
+              exposure_motion(cam, r, poses[i], pose_at(t - cfg.exposure_s / 2), pose_at(t + cfg.exposure_s / 2));
           motion_blur(r.color, m[0], m[1]);
         }
         const double gain = 1.0 + cfg.exposure_drift * (0.7 * std::sin(2 * M_PI * t / 23.0 + ph1) +
@@ -312,6 +317,7 @@ SynthSummary generate(const SynthConfig& cfg, const std::filesystem::path& out_d
   save_settings(settings, out_dir / "settings.yaml");
 
   nlohmann::json j;
+  j["generator"] = kGeneratorVersion;
   j["scenario"] = cfg.scenario;
   j["seed"] = cfg.seed;
   j["frames"] = n_frames;
@@ -321,6 +327,7 @@ SynthSummary generate(const SynthConfig& cfg, const std::filesystem::path& out_d
   j["path"] = {{"source", path_source}, {"start_s", cfg.path_start}, {"length_s", path_len}};
   j["room"] = {{"min", {room_lo.x(), room_lo.y(), room_lo.z()}}, {"max", {room_hi.x(), room_hi.y(), room_hi.z()}}};
   j["movers"] = movers.describe();
+  j["render_movers"] = cfg.render_movers;
   j["static_primitives"] = scene.statics.size();
   j["boxes"] = {{"miss_rate", cfg.box_miss_rate}, {"jitter_px", cfg.box_jitter_px}, {"written", summary.person_boxes},
                 {"frames_with_person", summary.frames_with_person}};

@@ -5,6 +5,8 @@
 #include <opencv2/imgproc.hpp>
 #include <random>
 
+#include "synth/fast_rng.hpp"
+
 namespace varslam::synth {
 
 namespace {
@@ -188,81 +190,134 @@ bool ObjectScript::pose_at(double t, Eigen::Isometry3d& pose) const {
   return false;
 }
 
-Movers Movers::script(const std::string& scenario, const ViewAnchor& anchor, double floor_y, double duration,
-                      const std::function<Eigen::Isometry3d(double)>& pose_at, std::uint64_t seed) {
+namespace {
+
+// Random draws for one mover, laid out in the anchor's frame (forward, right) on the floor.
+class MoverRng {
+ public:
+  MoverRng(std::uint64_t seed, const ViewAnchor& anchor)
+      : rng_(seed), c_(anchor.center.x(), anchor.center.z()), f_(anchor.forward.x(), anchor.forward.z()),
+        r_(anchor.right.x(), anchor.right.z()) {}
+  double uni(double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng_); }
+  std::uint64_t next() { return rng_(); }
+  /// Floor point fwd metres ahead of and lat metres right of the anchor, jittered by up to 25 cm.
+  Eigen::Vector2d at(double fwd, double lat) { return c_ + (fwd + uni(-0.25, 0.25)) * f_ + (lat + uni(-0.25, 0.25)) * r_; }
+  Eigen::Vector2d ahead(double fwd) const { return c_ + fwd * f_; }
+
+ private:
+  std::mt19937_64 rng_;
+  Eigen::Vector2d c_, f_, r_;
+};
+
+// Stream numbers of the mover groups (stable: changing one changes that mover only).
+enum Stream : std::uint64_t { kPeopleCount = 1, kCarriedBox = 2, kBalloon = 3, kObstructingBox = 4, kFirstPerson = 10 };
+
+PersonScript plan_person(std::size_t i, const ViewAnchor& anchor, std::uint64_t seed) {
+  MoverRng g(mix_seed(seed, kFirstPerson + i), anchor);
+  PersonScript p;
+  p.id = static_cast<std::uint8_t>(kFirstPersonId + i);
+  p.height = g.uni(1.6, 1.9);
+  p.speed = g.uni(0.85, 1.4);
+  switch (i) {
+    case 0: p.waypoints = {g.at(2.3, -2.7), g.at(2.6, 2.7)}; break;                  // across the view
+    case 1: p.waypoints = {g.at(4.0, 0.7), g.at(1.3, -0.2)}; break;                  // toward / away from the camera
+    default: p.waypoints = {g.at(3.6, 2.3), g.at(1.7, -1.2), g.at(3.1, -2.6)}; break;  // diagonal
+  }
+  p.start_offset = g.uni(0.0, 3.0);
+  p.look_seed = g.next();
+  return p;
+}
+
+ObjectScript plan_carried_box(const ViewAnchor& anchor, double floor_y, std::uint64_t seed) {
+  MoverRng g(mix_seed(seed, kCarriedBox), anchor);
+  ObjectScript o;
+  o.kind = ObjectScript::Kind::CarriedBox;
+  o.size = g.uni(0.38, 0.45);
+  o.speed = g.uni(0.7, 1.1);
+  const double hand_y = floor_y - g.uni(0.95, 1.1);
+  for (const auto& p : {g.at(1.8, -2.2), g.at(2.2, 0.0), g.at(2.6, 2.2)}) o.waypoints.emplace_back(p.x(), hand_y, p.y());
+  o.phase[0] = g.uni(0, 2);
+  o.phase[1] = g.uni(0, 6);
+  o.look_seed = g.next();
+  return o;
+}
+
+ObjectScript plan_balloon(const ViewAnchor& anchor, double floor_y, std::uint64_t seed) {
+  MoverRng g(mix_seed(seed, kBalloon), anchor);
+  ObjectScript o;
+  o.kind = ObjectScript::Kind::Balloon;
+  o.size = g.uni(0.32, 0.38);
+  const Eigen::Vector2d cc = g.ahead(g.uni(2.0, 2.6));
+  o.waypoints = {Eigen::Vector3d(cc.x(), floor_y - g.uni(1.3, 1.6), cc.y()), anchor.forward, anchor.right};
+  for (double& ph : o.phase) ph = g.uni(0, 2 * M_PI);
+  o.look_seed = g.next();
+  return o;
+}
+
+ObjectScript plan_obstructing_box(const ViewAnchor& anchor, double duration, const Movers::PoseAt& pose_at,
+                                  std::uint64_t seed) {
+  MoverRng g(mix_seed(seed, kObstructingBox), anchor);
+  ObjectScript o;
+  o.kind = ObjectScript::Kind::ObstructingBox;
+  o.size = g.uni(0.6, 0.7);
+  o.distance = g.uni(0.85, 1.0);
+  const double len = std::min(6.0, 0.7 * duration);
+  for (double s = std::min(1.5, 0.15 * duration); s + len <= duration + 1e-9; s += 10.0) {
+    ObjectScript::Episode e;
+    e.start = s;
+    e.length = len;
+    const Eigen::Isometry3d T = pose_at(s + len / 2);
+    e.cam_pos = T.translation();
+    Eigen::Vector3d fw = T.rotation().col(2);
+    fw.y() = 0;
+    e.forward = fw.norm() > 1e-6 ? fw.normalized() : Eigen::Vector3d::UnitZ();
+    e.right = Eigen::Vector3d::UnitY().cross(e.forward);
+    o.episodes.push_back(e);
+  }
+  o.look_seed = g.next();
+  return o;
+}
+
+}  // namespace
+
+Movers Movers::plan_all(const ViewAnchor& anchor, double floor_y, double duration, const PoseAt& pose_at,
+                        std::uint64_t seed) {
   Movers m;
   m.floor_y_ = floor_y;
-  std::mt19937_64 rng(seed);
-  auto uni = [&](double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); };
-  const Eigen::Vector2d c(anchor.center.x(), anchor.center.z());
-  const Eigen::Vector2d f(anchor.forward.x(), anchor.forward.z()), r(anchor.right.x(), anchor.right.z());
-  auto at = [&](double fwd, double lat) -> Eigen::Vector2d {
-    return c + (fwd + uni(-0.25, 0.25)) * f + (lat + uni(-0.25, 0.25)) * r;
-  };
-
-  const bool people = scenario == "walking" || scenario == "mixed";
-  if (people) {
-    std::vector<std::vector<Eigen::Vector2d>> lanes = {
-        {at(2.3, -2.7), at(2.6, 2.7)},                // across the view
-        {at(4.0, 0.7), at(1.3, -0.2)},                // toward / away from the camera
-        {at(3.6, 2.3), at(1.7, -1.2), at(3.1, -2.6)}  // diagonal
-    };
-    const int n = scenario == "mixed" ? 2 : (uni(0, 1) < 0.5 ? 2 : 3);
-    for (int i = 0; i < n; ++i) {
-      PersonScript p;
-      p.id = static_cast<std::uint8_t>(kFirstPersonId + i);
-      p.height = uni(1.6, 1.9);
-      p.speed = uni(0.85, 1.4);
-      p.waypoints = lanes[static_cast<std::size_t>(i)];
-      p.start_offset = uni(0.0, 3.0);
-      m.people_.push_back(p);
-    }
-  }
-  std::uint8_t next_id = kFirstObjectId;
-  if (scenario == "unknown_box" || scenario == "mixed") {
-    ObjectScript o;
-    o.kind = ObjectScript::Kind::CarriedBox;
-    o.id = next_id++;
-    o.size = uni(0.38, 0.45);
-    o.speed = uni(0.7, 1.1);
-    const double hand_y = floor_y - uni(0.95, 1.1);
-    for (const auto& p2 : {at(1.8, -2.2), at(2.2, 0.0), at(2.6, 2.2)}) o.waypoints.emplace_back(p2.x(), hand_y, p2.y());
-    o.phase[0] = uni(0, 2);
-    o.phase[1] = uni(0, 6);
-    m.objects_.push_back(o);
-  }
-  if (scenario == "balloon" || scenario == "mixed") {
-    ObjectScript o;
-    o.kind = ObjectScript::Kind::Balloon;
-    o.id = next_id++;
-    o.size = uni(0.32, 0.38);
-    const Eigen::Vector2d cc = c + uni(2.0, 2.6) * f;
-    o.waypoints = {Eigen::Vector3d(cc.x(), floor_y - uni(1.3, 1.6), cc.y()), anchor.forward, anchor.right};
-    for (double& ph : o.phase) ph = uni(0, 2 * M_PI);
-    m.objects_.push_back(o);
-  }
-  if (scenario == "obstructing_box") {
-    ObjectScript o;
-    o.kind = ObjectScript::Kind::ObstructingBox;
-    o.id = next_id++;
-    o.size = uni(0.6, 0.7);
-    o.distance = uni(0.85, 1.0);
-    const double len = std::min(6.0, 0.7 * duration);
-    for (double s = std::min(1.5, 0.15 * duration); s + len <= duration + 1e-9; s += 10.0) {
-      ObjectScript::Episode e;
-      e.start = s;
-      e.length = len;
-      const Eigen::Isometry3d T = pose_at(s + len / 2);
-      e.cam_pos = T.translation();
-      Eigen::Vector3d fw = T.rotation().col(2);
-      fw.y() = 0;
-      e.forward = fw.norm() > 1e-6 ? fw.normalized() : Eigen::Vector3d::UnitZ();
-      e.right = Eigen::Vector3d::UnitY().cross(e.forward);
-      o.episodes.push_back(e);
-    }
-    m.objects_.push_back(o);
-  }
+  for (std::size_t i = 0; i < 3; ++i) m.people_.push_back(plan_person(i, anchor, seed));
+  std::mt19937_64 count_rng(mix_seed(seed, kPeopleCount));
+  m.walking_people_ = std::uniform_real_distribution<double>(0, 1)(count_rng) < 0.5 ? 2 : 3;
+  m.objects_ = {plan_carried_box(anchor, floor_y, seed), plan_balloon(anchor, floor_y, seed),
+                plan_obstructing_box(anchor, duration, pose_at, seed)};
   return m;
+}
+
+Movers Movers::select(const std::string& scenario) const {
+  Movers m;
+  m.floor_y_ = floor_y_;
+  const std::size_t n_people = scenario == "walking" ? walking_people_ : scenario == "mixed" ? 2 : 0;
+  m.people_.assign(people_.begin(), people_.begin() + static_cast<std::ptrdiff_t>(std::min(n_people, people_.size())));
+  m.walking_people_ = m.people_.size();
+  auto wanted = [&](ObjectScript::Kind k) {
+    switch (k) {
+      case ObjectScript::Kind::CarriedBox: return scenario == "unknown_box" || scenario == "mixed";
+      case ObjectScript::Kind::Balloon: return scenario == "balloon" || scenario == "mixed";
+      case ObjectScript::Kind::ObstructingBox: return scenario == "obstructing_box";
+    }
+    return false;
+  };
+  std::uint8_t next_id = kFirstObjectId;
+  for (const auto& o : objects_)
+    if (wanted(o.kind)) {
+      m.objects_.push_back(o);
+      m.objects_.back().id = next_id++;
+    }
+  return m;
+}
+
+Movers Movers::script(const std::string& scenario, const ViewAnchor& anchor, double floor_y, double duration,
+                      const PoseAt& pose_at, std::uint64_t seed) {
+  return plan_all(anchor, floor_y, duration, pose_at, seed).select(scenario);
 }
 
 std::vector<KeepOut> Movers::keep_outs() const {
@@ -293,14 +348,14 @@ std::vector<Eigen::Vector3d> Movers::extent_points() const {
   return out;
 }
 
-void Movers::add_materials(Scene& scene, std::uint64_t seed) {
-  std::mt19937_64 rng(seed);
-  auto uni = [&](double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); };
-  auto col = [&](int lo, int hi) {
-    return cv::Vec3b(static_cast<uchar>(uni(lo, hi)), static_cast<uchar>(uni(lo, hi)), static_cast<uchar>(uni(lo, hi)));
-  };
+void Movers::add_materials(Scene& scene) {
   const cv::Vec3b skins[] = {{150, 180, 225}, {110, 145, 195}, {70, 100, 150}, {130, 165, 210}};
   for (auto& p : people_) {
+    std::mt19937_64 rng(p.look_seed);
+    auto uni = [&](double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); };
+    auto col = [&](int lo, int hi) {
+      return cv::Vec3b(static_cast<uchar>(uni(lo, hi)), static_cast<uchar>(uni(lo, hi)), static_cast<uchar>(uni(lo, hi)));
+    };
     p.shirt_color = col(30, 230);
     p.shirt_pattern = static_cast<int>(uni(0, 2.99));
     p.shirt = scene.add_material(scene.add_texture(texgen::fabric(256, p.shirt_color, p.shirt_pattern, rng())), 0.002, "shirt");
@@ -311,6 +366,7 @@ void Movers::add_materials(Scene& scene, std::uint64_t seed) {
     p.shoes = scene.add_material(scene.add_texture(texgen::plain(64, col(10, 50), rng())), 0.005, "shoes");
   }
   for (auto& o : objects_) {
+    std::mt19937_64 rng(o.look_seed);
     if (o.kind == ObjectScript::Kind::Balloon) {
       cv::Mat tex = texgen::fabric(256, cv::Vec3b(40, 40, 200), 0, rng());
       cv::circle(tex, cv::Point(128, 128), 50, cv::Scalar(240, 240, 240), -1, cv::LINE_AA);  // printed logo

@@ -1,6 +1,8 @@
 #pragma once
 // Scripted movers: articulated walking people (with a gait) and unknown objects (carried box, obstructing box,
 // balloon). Scripts are laid out relative to where the camera looks, so movers are in view much of the time.
+// The movers of all scenarios are planned together (one RNG stream per mover), so the static room, which is laid
+// out around every planned mover, is the same for every scenario; a scenario only selects which movers appear.
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <functional>
@@ -21,6 +23,7 @@ struct PersonScript {
   int shirt = 0, trousers = 0, skin = 0, hair = 0, shoes = 0;  // materials
   cv::Vec3b shirt_color{0, 0, 0};
   int shirt_pattern = 0;
+  std::uint64_t look_seed = 0;  // clothing and skin textures
 
   /// Floor position and unit heading (x, z) at time t; phase = gait phase in radians.
   void state_at(double t, Eigen::Vector2d& pos, Eigen::Vector2d& heading, double& phase) const;
@@ -44,6 +47,7 @@ struct ObjectScript {
   };
   std::vector<Episode> episodes;
   double distance = 1.1;
+  std::uint64_t look_seed = 0;  // texture
 
   /// Pose of the object at t; false when it is not in the scene (obstructing box between episodes).
   bool pose_at(double t, Eigen::Isometry3d& pose) const;
@@ -51,16 +55,24 @@ struct ObjectScript {
 
 class Movers {
  public:
-  /// Lay out the scenario's movers. pose_at(t) = camera-to-world pose at t seconds after the start.
+  using PoseAt = std::function<Eigen::Isometry3d(double)>;
+
+  /// Every mover any scenario uses (three people, carried box, balloon, obstructing box), each from its own RNG
+  /// stream, so a mover does not depend on which others exist. pose_at(t) = camera-to-world pose at t seconds.
+  static Movers plan_all(const ViewAnchor& anchor, double floor_y, double duration, const PoseAt& pose_at,
+                         std::uint64_t seed);
+  /// The movers of one scenario, taken from this plan (object ids renumbered from kFirstObjectId).
+  Movers select(const std::string& scenario) const;
+  /// plan_all(...).select(scenario).
   static Movers script(const std::string& scenario, const ViewAnchor& anchor, double floor_y, double duration,
-                       const std::function<Eigen::Isometry3d(double)>& pose_at, std::uint64_t seed);
+                       const PoseAt& pose_at, std::uint64_t seed);
 
   /// Floor zones that furniture must leave free (walking lanes).
   std::vector<KeepOut> keep_outs() const;
   /// Points (world) the room must enclose.
   std::vector<Eigen::Vector3d> extent_points() const;
-  /// Create clothing / object textures and materials in the scene.
-  void add_materials(Scene& scene, std::uint64_t seed);
+  /// Create clothing / object textures and materials in the scene (from each mover's look_seed).
+  void add_materials(Scene& scene);
   /// All mover primitives at time t (seconds since the start).
   void primitives_at(double t, std::vector<Primitive>& out) const;
   nlohmann::json describe() const;
@@ -72,6 +84,7 @@ class Movers {
   std::vector<PersonScript> people_;
   std::vector<ObjectScript> objects_;
   double floor_y_ = 0.0;
+  std::size_t walking_people_ = 0;  // how many of the planned people the walking scenario shows
 };
 
 /// Body parts of one person in world coordinates (exposed for tests).

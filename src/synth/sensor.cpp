@@ -15,6 +15,10 @@ cv::Mat1w sense_depth(const cv::Mat1f& depth_m, const DepthSensorParams& p, Spli
     const float* dn = depth_m.ptr<float>(std::min(H - 1, v + 1));
     auto* o = out.ptr<std::uint16_t>(v);
     for (int u = 0; u < W; ++u) {
+      // Two draws per pixel whatever it shows, so a pixel's noise does not depend on the content elsewhere in the
+      // image: scenes that differ only by a mover get identical noise away from the mover.
+      const double hole_draw = p.edge_holes ? rng.uniform() : 1.0;
+      const float noise_draw = p.noise ? gauss.draw(rng) : 0.0f;
       double z = d[u];
       if (z <= 0 || (p.max_range_m > 0 && z > p.max_range_m)) {
         o[u] = 0;
@@ -27,12 +31,12 @@ cv::Mat1w sense_depth(const cv::Mat1f& depth_m, const DepthSensorParams& p, Spli
         const float jump = std::max({std::abs(l - d[u]), std::abs(r - d[u]), std::abs(up[u] - d[u]), std::abs(dn[u] - d[u])});
         const bool far_side = l < d[u] - 0.04f * d[u] || r < d[u] - 0.04f * d[u] || up[u] < d[u] - 0.04f * d[u] ||
                               dn[u] < d[u] - 0.04f * d[u];
-        if (jump > 0.04f * d[u] && rng.uniform() < (far_side ? 0.9 : 0.5)) {
+        if (jump > 0.04f * d[u] && hole_draw < (far_side ? 0.9 : 0.5)) {
           o[u] = 0;
           continue;
         }
       }
-      if (p.noise) z += kinect_depth_sigma(z) * gauss.draw(rng);
+      if (p.noise) z += kinect_depth_sigma(z) * noise_draw;
       const double raw = std::round(z * p.depth_factor);
       o[u] = static_cast<std::uint16_t>(std::clamp(raw, 0.0, 65535.0));
     }

@@ -142,6 +142,24 @@ TEST(Settings, ReadsThe7ScenesOrbSlam3File) {
   EXPECT_EQ(setting_or<std::string>(s, "Camera.type", ""), "PinHole");
 }
 
+TEST(Settings, EditedDocumentIsReadAgainIncludingCameraDepthAndOrbFields) {
+  const std::filesystem::path file = std::filesystem::path(VARSLAM_SHARED_DIR) /
+                                     "realdata/7scenes_redkitchen/settings.yaml";
+  if (!std::filesystem::exists(file)) GTEST_SKIP() << "shared data not present: " << file;
+  Settings s = load_settings(file);
+  // What `--set camera.fx=528 --set depth.th_depth=25 --set orb.n_features=1500` does to an ORB-SLAM3 file.
+  s.root["camera"]["fx"] = 528.0;
+  s.root["depth"]["th_depth"] = 25.0;
+  s.root["orb"]["n_features"] = 1500;
+  const Settings r = settings_from_yaml(s.root, s.source);
+  EXPECT_DOUBLE_EQ(r.camera.fx, 528.0);
+  EXPECT_DOUBLE_EQ(r.camera.fy, 585.0);
+  EXPECT_DOUBLE_EQ(r.th_depth, 25.0);
+  EXPECT_EQ(r.orb.n_features, 1500);
+  EXPECT_DOUBLE_EQ(r.depth_factor, 1000.0);
+  EXPECT_EQ(r.source, file);
+}
+
 TEST(Settings, ReadsTheOlderOrbSlamLayoutWithOpenCvHeaderAndMatrixTags) {
   TempDir dir;
   const auto file = dir.write("TUM1.yaml", R"(%YAML:1.0

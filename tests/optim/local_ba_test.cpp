@@ -197,6 +197,46 @@ TEST(LocalBa, SolveFirstStartsFromTheConfiguredAlpha) {
   EXPECT_LT(mean_translation_error(solved, s.truth), 0.2 * mean_translation_error(s.initial, s.truth));
 }
 
+TEST(LocalBa, AnUnchangedAlphaCostsNoExtraCeresSolve) {
+  // Initial state at the truth: only pixel noise, so the per-component fit finds the same alpha at every
+  // checkpoint, and the alternation must go on in the same Ceres solve: no more solves than Huber's schedule.
+  const PinholeCamera cam;
+  SyntheticBa s = small_problem(4, 0.0);
+  BaConfig cfg = ba_config(KernelType::BarronAdaptive);
+  cfg.kernel.fit = robust::AlphaFit::PerComponent;
+  cfg.outer_iterations = 4;
+  cfg.iterations = 1;  // a checkpoint after every iteration: a restart at each would show
+  BaConfig huber_cfg = cfg;
+  huber_cfg.kernel.type = KernelType::Huber;
+  BaProblem adaptive = s.initial, huber = s.initial;
+  const BaResult ra = solve_local_ba(cam, adaptive, cfg);
+  const BaResult rh = solve_local_ba(cam, huber, huber_cfg);
+  ASSERT_EQ(ra.alpha_per_iteration.size(), static_cast<std::size_t>(cfg.outer_iterations + 1));
+  for (int k = 1; k < cfg.outer_iterations; ++k) ASSERT_EQ(ra.alpha_per_iteration[k], ra.alpha_per_iteration[0]);
+  ASSERT_GT(ra.solver_iterations, 2 * cfg.iterations);  // the solve ran past checkpoints
+  EXPECT_GT(ra.solves, 0);
+  EXPECT_LE(ra.solves, rh.solves);
+}
+
+TEST(LocalBa, AMovingAlphaRestartsTheSolveAtItsCheckpoint) {
+  // From a perturbed start with wrong matches the fitted alpha moves between checkpoints: each move ends the
+  // running Ceres solve (at most one solve per checkpoint, plus the refine), and the log keeps one alpha per
+  // checkpoint.
+  const PinholeCamera cam;
+  SyntheticBa s = small_problem(5);
+  add_gross_outliers(cam, s, 5);
+  const BaConfig cfg = ba_config(KernelType::BarronAdaptive);
+  BaProblem solved = s.initial;
+  const BaResult r = solve_local_ba(cam, solved, cfg);
+  ASSERT_EQ(r.alpha_per_iteration.size(), static_cast<std::size_t>(cfg.outer_iterations + 1));
+  int moves = 0;
+  for (int k = 1; k < cfg.outer_iterations; ++k) moves += r.alpha_per_iteration[k] != r.alpha_per_iteration[k - 1];
+  ASSERT_GT(moves, 0);
+  EXPECT_GE(r.solves, 1 + moves);
+  EXPECT_LE(r.solves, cfg.outer_iterations + 1);
+  EXPECT_LE(r.solver_iterations, cfg.outer_iterations * cfg.iterations + cfg.refine_iterations);
+}
+
 TEST(LocalBa, RejectsObservationOfMissingPoint) {
   SyntheticBa s = small_problem(3);
   s.initial.observations.push_back({0, static_cast<int>(s.initial.points.size()), {}});

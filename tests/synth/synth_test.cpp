@@ -1,4 +1,5 @@
-// Generator tests: output layout and parsing, determinism, sensor statistics, boxes, poses, config errors.
+// Generator tests: output layout and parsing, determinism, sensor statistics, boxes, poses, config errors, and the
+// static world being the same for every scenario (only the movers differ).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -214,16 +215,27 @@ TEST(Synth, PeopleBoxesAreInsideTheImageAndPresentWhenPeopleAreVisible) {
   const BoxesByTime jittered = read_boxes_file(dir / "boxes.txt");
   ASSERT_EQ(jittered.size(), boxes.size());
   double moved = 0;
+  std::size_t matched = 0;
   for (const auto& [t, dets] : jittered) {
     const auto& ref = boxes.at(t);
-    ASSERT_EQ(dets.size(), ref.size());
-    for (std::size_t i = 0; i < dets.size(); ++i) {
-      moved += std::abs(dets[i].box.x - ref[i].box.x);
-      EXPECT_GE(dets[i].box.x, 0.0f);
-      EXPECT_LE(dets[i].box.x + dets[i].box.width, 640.0f);
+    ASSERT_LE(dets.size(), ref.size());
+    for (const auto& d : dets) {
+      EXPECT_GE(d.box.x, 0.0f);
+      EXPECT_LE(d.box.x + d.box.width, 640.0f);
+    }
+    // Every box clearly wider than the jitter survives it, near its unjittered place. (A sliver at the image
+    // border may be jittered out of the image.)
+    for (const auto& r : ref) {
+      if (r.box.width < 30 || r.box.height < 30) continue;
+      double best = 1e9;
+      for (const auto& d : dets) best = std::min(best, static_cast<double>(std::abs(d.box.x - r.box.x)));
+      EXPECT_LT(best, 20.0) << "box at t=" << t << " lost by the jitter";
+      moved += best;
+      ++matched;
     }
   }
-  EXPECT_GT(moved / static_cast<double>(s.person_boxes), 1.0);
+  ASSERT_GT(matched, 0u);
+  EXPECT_GT(moved / static_cast<double>(matched), 1.0);
   fs::remove_all(dir);
 }
 
@@ -321,7 +333,7 @@ TEST(SynthMovers, ObstructingBoxFillsALargePartOfTheImage) {
   const auto& ep = movers.objects()[0].episodes.at(0);
   Scene scene = build_static_scene({-4, -1.4, -2}, {4, 1.35, 6}, anchor, {}, 1);
   Movers m = movers;
-  m.add_materials(scene, 2);
+  m.add_materials(scene);
   const Renderer renderer{PinholeCamera{}};
   RenderOutput out;
   double max_share = 0;
@@ -370,4 +382,126 @@ TEST(SynthMovers, PeopleAreHumanSizedAndWalkAtHumanSpeed) {
     EXPECT_GE(speeds[10], 0.8);
     EXPECT_LE(speeds[10], 1.5 + 1e-9);
   }
+}
+
+namespace {
+
+// Byte comparison of every frame (colour and depth) of two generated folders; returns the number of frames that differ.
+std::size_t differing_frames(const fs::path& a, const fs::path& b) {
+  const auto list_a = read_list(a / "rgb.txt"), list_b = read_list(b / "rgb.txt");
+  const auto depth_a = read_list(a / "depth.txt"), depth_b = read_list(b / "depth.txt");
+  EXPECT_EQ(list_a.size(), list_b.size());
+  EXPECT_FALSE(list_a.empty());
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < std::min(list_a.size(), list_b.size()); ++i) {
+    EXPECT_EQ(list_a[i], list_b[i]);
+    const bool same = slurp(a / list_a[i].second) == slurp(b / list_b[i].second) &&
+                      slurp(a / depth_a[i].second) == slurp(b / depth_b[i].second);
+    if (!same) ++differ;
+  }
+  return differ;
+}
+
+SynthConfig world_config(const std::string& scenario) {
+  auto cfg = short_config(scenario, 0.4, 10.0);
+  cfg.seed = 5;
+  cfg.preview = false;
+  return cfg;
+}
+
+}  // namespace
+
+TEST(SynthWorld, EveryScenarioWithHiddenMoversRendersExactlyTheStaticSequence) {
+  const fs::path ref = temp_dir("world_static"), dir = temp_dir("world_hidden");
+  generate(world_config("static"), ref);
+  const auto static_json = nlohmann::json::parse(slurp(ref / "scenario.json"));
+  for (const auto& name : scenario_names()) {
+    SCOPED_TRACE(name);
+    auto cfg = world_config(name);
+    cfg.render_movers = false;
+    generate(cfg, dir);
+    EXPECT_EQ(differing_frames(ref, dir), 0u);
+    const auto j = nlohmann::json::parse(slurp(dir / "scenario.json"));
+    EXPECT_EQ(j.at("room"), static_json.at("room"));
+    EXPECT_EQ(j.at("static_primitives"), static_json.at("static_primitives"));
+    EXPECT_EQ(j.at("render_movers"), false);
+    EXPECT_TRUE(read_boxes_file(dir / "boxes.txt").empty());
+  }
+  fs::remove_all(ref);
+  fs::remove_all(dir);
+}
+
+TEST(SynthWorld, VisibleMoversAreTheOnlyDifferenceFromStatic) {
+  // Same seed, same path: walking differs from static only around the people (their pixels, the depth holes at
+  // their outline, the motion blur spreading their colour); the sensor noise elsewhere is the same.
+  const fs::path ref = temp_dir("world_static2"), dir = temp_dir("world_walking");
+  auto cfg = world_config("static");
+  cfg.seconds = 2.0;
+  cfg.fps = 5.0;
+  generate(cfg, ref);
+  cfg.scenario = "walking";
+  const SynthSummary s = generate(cfg, dir);
+  ASSERT_GT(s.frames_with_person, 0u);
+  EXPECT_GE(differing_frames(ref, dir), s.frames_with_person);  // movers are rendered
+  const BoxesByTime boxes = read_boxes_file(dir / "boxes.txt");
+  const auto colour = read_list(dir / "rgb.txt"), depth = read_list(dir / "depth.txt");
+  std::size_t changed_inside = 0;
+  for (std::size_t i = 0; i < colour.size(); ++i) {
+    cv::Mat1b outside(480, 640, uchar{255});
+    for (const auto& [t, dets] : boxes)
+      if (std::abs(t - colour[i].first) < 1e-6)
+        for (const auto& d : dets) {
+          const cv::Rect grown = cv::Rect(d.box) + cv::Size(32, 32) - cv::Point(16, 16);  // blur reach
+          outside(grown & cv::Rect(0, 0, 640, 480)).setTo(0);
+        }
+    for (const auto& name : {colour[i].second, depth[i].second}) {
+      const cv::Mat a = cv::imread((ref / name).string(), cv::IMREAD_UNCHANGED);
+      const cv::Mat b = cv::imread((dir / name).string(), cv::IMREAD_UNCHANGED);
+      cv::Mat diff;
+      cv::absdiff(a, b, diff);
+      std::vector<cv::Mat> channels;
+      cv::split(diff, channels);
+      cv::Mat any = channels[0];
+      for (std::size_t c = 1; c < channels.size(); ++c) any = any | channels[c];
+      const cv::Mat1b per_pixel = any != 0;
+      changed_inside += static_cast<std::size_t>(cv::countNonZero(per_pixel & ~outside));
+      EXPECT_EQ(cv::countNonZero(per_pixel & outside), 0) << name;
+    }
+  }
+  EXPECT_GT(changed_inside, 1000u);
+  fs::remove_all(ref);
+  fs::remove_all(dir);
+}
+
+TEST(SynthMovers, EachScenarioSelectsItsMoversFromOneSharedPlan) {
+  const auto still = [](double) { return Eigen::Isometry3d(Eigen::Isometry3d::Identity()); };
+  const Movers plan = Movers::plan_all(ViewAnchor{}, 1.35, 10.0, still, 4);
+  ASSERT_EQ(plan.people().size(), 3u);
+  ASSERT_EQ(plan.objects().size(), 3u);
+  EXPECT_TRUE(plan.select("static").people().empty());
+  EXPECT_TRUE(plan.select("static").objects().empty());
+  EXPECT_TRUE(plan.select("static").keep_outs().empty());
+  const Movers walking = plan.select("walking"), mixed = plan.select("mixed");
+  EXPECT_GE(walking.people().size(), 2u);
+  EXPECT_TRUE(walking.objects().empty());
+  ASSERT_EQ(mixed.people().size(), 2u);
+  ASSERT_EQ(mixed.objects().size(), 2u);
+  // The same person walks the same lane in every scenario that shows them.
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(mixed.people()[i].waypoints, walking.people()[i].waypoints);
+    EXPECT_EQ(mixed.people()[i].height, walking.people()[i].height);
+    EXPECT_EQ(mixed.people()[i].look_seed, walking.people()[i].look_seed);
+  }
+  EXPECT_EQ(mixed.objects()[0].kind, ObjectScript::Kind::CarriedBox);
+  EXPECT_EQ(mixed.objects()[1].kind, ObjectScript::Kind::Balloon);
+  EXPECT_EQ(mixed.objects()[1].id, kFirstObjectId + 1);
+  const Movers balloon = plan.select("balloon");
+  ASSERT_EQ(balloon.objects().size(), 1u);
+  EXPECT_EQ(balloon.objects()[0].id, kFirstObjectId);  // ids renumbered per scenario
+  EXPECT_EQ(balloon.objects()[0].waypoints, mixed.objects()[1].waypoints);
+  EXPECT_EQ(plan.select("obstructing_box").objects().at(0).kind, ObjectScript::Kind::ObstructingBox);
+  // The plan's keep-outs cover every scenario's lanes.
+  EXPECT_GE(plan.keep_outs().size(), walking.keep_outs().size() + plan.select("unknown_box").keep_outs().size());
+  // Another seed moves the movers.
+  EXPECT_NE(Movers::plan_all(ViewAnchor{}, 1.35, 10.0, still, 5).people()[0].waypoints, plan.people()[0].waypoints);
 }

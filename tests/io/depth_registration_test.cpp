@@ -1,0 +1,79 @@
+// register_depth_to_colour: a separate depth camera's image moved into the colour camera's pixel grid.
+#include <gtest/gtest.h>
+
+#include "io/depth_image.hpp"
+
+namespace varslam {
+namespace {
+
+PinholeCamera camera(double f, double cx, double cy) {
+  PinholeCamera c;
+  c.fx = c.fy = f;
+  c.cx = cx;
+  c.cy = cy;
+  c.width = 64;
+  c.height = 48;
+  return c;
+}
+
+cv::Mat plane(float z) { return cv::Mat(48, 64, CV_32FC1, cv::Scalar(z)); }
+
+TEST(RegisterDepth, IdenticalCamerasLeaveTheImageUnchanged) {
+  cv::Mat d = plane(2.0f);
+  d.at<float>(10, 20) = 1.0f;
+  d.at<float>(30, 40) = 0.0f;  // a hole stays a hole
+  DepthCameraRig rig{camera(50, 32, 24), Eigen::Vector3d::Zero()};
+  const cv::Mat r = register_depth_to_colour(d, rig, camera(50, 32, 24));
+  EXPECT_EQ(cv::norm(r, d, cv::NORM_INF), 0.0);
+}
+
+TEST(RegisterDepth, TranslationShiftsPixelsByTheParallax) {
+  // A 1 m square patch in front of a 4 m wall; the depth camera sits 0.1 m to the colour camera's left, so the
+  // patch appears f * 0.1 / 1 = 5 px further left in colour, the wall 1.25 px (rounded to 1).
+  cv::Mat d = plane(4.0f);
+  for (int v = 20; v < 28; ++v)
+    for (int u = 28; u < 36; ++u) d.at<float>(v, u) = 1.0f;
+  DepthCameraRig rig{camera(50, 32, 24), Eigen::Vector3d(-0.1, 0.0, 0.0)};
+  const cv::Mat r = register_depth_to_colour(d, rig, camera(50, 32, 24));
+  for (int u = 23; u < 31; ++u) EXPECT_FLOAT_EQ(r.at<float>(24, u), 1.0f) << "u=" << u;
+  EXPECT_FLOAT_EQ(r.at<float>(24, 22), 4.0f);
+  // Behind the patch's old right side the wall was occluded in depth: nothing lands there (no made-up depth).
+  EXPECT_FLOAT_EQ(r.at<float>(24, 33), 0.0f);
+  EXPECT_FLOAT_EQ(r.at<float>(24, 40), 4.0f);
+}
+
+TEST(RegisterDepth, NearerSurfaceWinsWhereTwoLandOnOnePixel) {
+  // With a 0.1 m shift a point moves f * 0.1 / z px: z = 0.5 from u=35 and z = 1 from u=30 both land on u=25.
+  cv::Mat d(48, 64, CV_32FC1, cv::Scalar(0.0f));
+  d.at<float>(24, 35) = 0.5f;  // moves 10 px to u=25
+  d.at<float>(24, 30) = 1.0f;  // moves 5 px to u=25
+  DepthCameraRig rig{camera(50, 32, 24), Eigen::Vector3d(-0.1, 0.0, 0.0)};
+  const cv::Mat r = register_depth_to_colour(d, rig, camera(50, 32, 24));
+  EXPECT_FLOAT_EQ(r.at<float>(24, 25), 0.5f);
+  EXPECT_EQ(cv::countNonZero(r), 1);
+}
+
+TEST(RegisterDepth, WiderColourLensPullsPixelsTowardsTheCentre) {
+  // Depth f=60, colour f=50: a depth pixel 12 px right of the centre sits 10 px right of it in colour.
+  cv::Mat d(48, 64, CV_32FC1, cv::Scalar(0.0f));
+  d.at<float>(24 + 6, 32 + 12) = 2.0f;
+  DepthCameraRig rig{camera(60, 32, 24), Eigen::Vector3d::Zero()};
+  const cv::Mat r = register_depth_to_colour(d, rig, camera(50, 32, 24));
+  EXPECT_FLOAT_EQ(r.at<float>(24 + 5, 32 + 10), 2.0f);
+  EXPECT_EQ(cv::countNonZero(r), 1);
+}
+
+TEST(RegisterDepth, OutputHasTheColourCameraSize) {
+  PinholeCamera colour = camera(50, 40, 30);
+  colour.width = 80;
+  colour.height = 60;
+  DepthCameraRig rig{camera(50, 32, 24), Eigen::Vector3d::Zero()};
+  const cv::Mat r = register_depth_to_colour(plane(1.0f), rig, colour);
+  EXPECT_EQ(r.cols, 80);
+  EXPECT_EQ(r.rows, 60);
+  EXPECT_FLOAT_EQ(r.at<float>(30, 40), 1.0f);  // principal points coincide
+  EXPECT_FLOAT_EQ(r.at<float>(2, 2), 0.0f);     // outside what the depth camera sees
+}
+
+}  // namespace
+}  // namespace varslam
