@@ -110,7 +110,9 @@ class Builder {
       for (int side : {0, 1}) {
         const int other = axis == 0 ? 2 : 0;
         const double len = hi[other] - lo[other];
-        const int n = 2 + static_cast<int>(uni(0, 2.99));
+        // The wall the camera faces gets more: with the middle of the room kept free for the movers of every
+        // scenario, it is most of what the camera sees.
+        const int n = (facing_camera(axis, side) ? 6 : 3) + static_cast<int>(uni(0, 2.99));
         for (int i = 0; i < n; ++i) {
           const double slot = lo[other] + len * (i + 0.5) / n + uni(-0.2, 0.2) * len / n;
           if (!whiteboard_done && i == 0 && facing_camera(axis, side)) {
@@ -247,6 +249,36 @@ class Builder {
         placed_.push_back(fp);
       }
       ++placed;
+    }
+    // The movers of every scenario keep the middle of the room free (the room must not depend on the scenario),
+    // so fill up along the walls, where real rooms keep their shelves: bookcases and cabinets backed onto a wall.
+    // Mostly the wall the camera faces: what it sees behind the movers.
+    int along_walls = 0;
+    for (tries = 0; along_walls < 4 && tries < 300; ++tries) {
+      int axis = uni(0, 1) < 0.5 ? 0 : 2, side = uni(0, 1) < 0.5 ? 0 : 1;
+      if (uni(0, 1) < 0.75)
+        for (int a : {0, 2})
+          for (int sd : {0, 1})
+            if (facing_camera(a, sd)) axis = a, side = sd;
+      const int other = axis == 0 ? 2 : 0;
+      const double depth = uni(0.3, 0.45), width = uni(0.7, 1.2);
+      const double wall = side == 0 ? scene_.room_lo[axis] + 0.06 : scene_.room_hi[axis] - 0.06 - depth;
+      const double along = uni(scene_.room_lo[other] + 0.1, scene_.room_hi[other] - 0.1 - width);
+      Eigen::Vector2d lo, hi;  // (x, z)
+      lo[axis == 0 ? 0 : 1] = wall;
+      hi[axis == 0 ? 0 : 1] = wall + depth;
+      lo[other == 0 ? 0 : 1] = along;
+      hi[other == 0 ? 0 : 1] = along + width;
+      const Footprint fp{lo.x(), lo.y(), hi.x(), hi.y()};
+      if (!free_spot(fp)) continue;
+      if (uni(0, 1) < 0.65) {
+        bookcase(fp, uni(1.6, 2.0));
+      } else {
+        const double h = uni(0.8, 1.2);
+        scene_.statics.push_back(box({fp.x0, floor - h, fp.z0}, {fp.x1, floor, fp.z1}, painted_, table_wood_));
+        placed_.push_back(fp);
+      }
+      ++along_walls;
     }
     // A rug under the action area (low texture variation, on the floor).
     const Eigen::Vector3d rc = anchor_.center + 2.5 * anchor_.forward;

@@ -10,8 +10,9 @@
 namespace varslam::synth {
 
 /// Changes whenever the same configuration renders different files (written to scenario.json; the bench cache
-/// key in report/bench_matrix.cpp repeats it). 2: the static room is the same for every scenario.
-inline constexpr int kGeneratorVersion = 2;
+/// key in report/bench_matrix.cpp repeats it). 2: the static room is the same for every scenario; 3: shelves
+/// and cabinets along the walls where the movers leave the middle free.
+inline constexpr int kGeneratorVersion = 3;
 
 struct SynthConfig {
   std::string scenario = "walking";  // static | walking | unknown_box | obstructing_box | balloon | mixed
