@@ -7,6 +7,7 @@
 #include <deque>
 #include <exception>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -44,8 +45,9 @@ Settings settings_for_dataset(const std::filesystem::path& dir, const std::optio
 /// Decodes frames [first, first + count) ahead on its own thread so decoding overlaps with processing.
 class FramePrefetcher {
  public:
+  /// `prepare` (optional) runs on each loaded frame on the prefetch thread, e.g. depth registration.
   FramePrefetcher(const Dataset& ds, std::size_t queue_depth = 4, std::size_t first = 0,
-                  std::size_t count = SIZE_MAX);
+                  std::size_t count = SIZE_MAX, std::function<void(RgbdFrame&)> prepare = {});
   ~FramePrefetcher();  // stops and joins
   FramePrefetcher(const FramePrefetcher&) = delete;
   FramePrefetcher& operator=(const FramePrefetcher&) = delete;
@@ -62,6 +64,7 @@ class FramePrefetcher {
   const std::size_t queue_depth_;
   const std::size_t first_;
   const std::size_t end_;
+  const std::function<void(RgbdFrame&)> prepare_;
   mutable std::mutex mutex_;
   std::condition_variable not_full_, not_empty_;
   std::deque<RgbdFrame> queue_;

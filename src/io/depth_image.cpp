@@ -39,10 +39,6 @@ double median_valid_depth(const cv::Mat& metres, int step) {
   return *mid;
 }
 
-}  // namespace varslam
-
-namespace varslam {
-
 cv::Mat register_depth_to_colour(const cv::Mat& depth_m, const DepthCameraRig& rig, const PinholeCamera& colour) {
   CV_Assert(depth_m.type() == CV_32FC1);
   cv::Mat out(colour.height, colour.width, CV_32FC1, cv::Scalar(0.0f));

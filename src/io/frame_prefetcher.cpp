@@ -8,11 +8,13 @@
 
 namespace varslam {
 
-FramePrefetcher::FramePrefetcher(const Dataset& ds, std::size_t queue_depth, std::size_t first, std::size_t count)
+FramePrefetcher::FramePrefetcher(const Dataset& ds, std::size_t queue_depth, std::size_t first, std::size_t count,
+                                 std::function<void(RgbdFrame&)> prepare)
     : ds_(ds),
       queue_depth_(std::max<std::size_t>(queue_depth, 1)),
       first_(std::min(first, ds.size())),
       end_(first_ + std::min(count, ds.size() - first_)),
+      prepare_(std::move(prepare)),
       worker_([this] { run(); }) {}
 
 FramePrefetcher::~FramePrefetcher() {
@@ -46,6 +48,7 @@ void FramePrefetcher::run() {
                                        ds_.root().string(), skipped_, total, max_skips, e.what()));
         continue;
       }
+      if (prepare_) prepare_(*frame);
       std::unique_lock lock(mutex_);
       not_full_.wait(lock, [this] { return stop_ || queue_.size() < queue_depth_; });
       if (stop_) break;

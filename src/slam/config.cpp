@@ -46,12 +46,13 @@ void read_kernel(const Settings& s, const std::string& section, optim::KernelCon
 // The depth camera's intrinsics and its origin in the colour frame; absent (registered depth) without
 // depth.camera_fx. Its image size is the colour camera's (both 640x480 on a Kinect).
 std::optional<DepthCameraRig> read_depth_rig(const Settings& s) {
-  if (setting_or<double>(s, "depth.camera_fx", 0.0) == 0.0) return std::nullopt;
+  const double fx = setting_or<double>(s, "depth.camera_fx", 0.0);
+  if (fx == 0.0) return std::nullopt;
   DepthCameraRig rig;
   PinholeCamera& d = rig.depth;
   d.width = s.camera.width;
   d.height = s.camera.height;
-  d.fx = setting_or<double>(s, "depth.camera_fx", 0.0);
+  d.fx = fx;
   d.fy = setting_or<double>(s, "depth.camera_fy", d.fx);
   d.cx = setting_or<double>(s, "depth.camera_cx", s.camera.cx);
   d.cy = setting_or<double>(s, "depth.camera_cy", s.camera.cy);

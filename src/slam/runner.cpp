@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <thread>
 
 #include "core/error.hpp"
@@ -98,7 +99,14 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const Slam
     });
   }
 
-  FramePrefetcher prefetch(dataset, 4, first, count);
+  // Unregistered depth (separate depth camera): warped into the colour camera on the prefetch thread, before
+  // any stage reads it.
+  std::function<void(RgbdFrame&)> prepare;
+  if (cfg.tracking.depth_rig)
+    prepare = [rig = *cfg.tracking.depth_rig, colour = settings.camera](RgbdFrame& f) {
+      f.depth = register_depth_to_colour(f.depth, rig, colour);
+    };
+  FramePrefetcher prefetch(dataset, 4, first, count, std::move(prepare));
   std::vector<FrameLog> logs;
   logs.reserve(count);
   const auto t_start = Clock::now();
@@ -110,9 +118,6 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const Slam
     std::optional<RgbdFrame> frame = prefetch.next();
     const double load_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_load).count();
     if (!frame) break;
-    // Unregistered depth (separate depth camera): warp it into the colour camera before any stage reads it.
-    if (cfg.tracking.depth_rig)
-      frame->depth = register_depth_to_colour(frame->depth, *cfg.tracking.depth_rig, settings.camera);
     if (n == 0) first_stamp = frame->timestamp;
     if (options.mode == RunMode::RealTime && options.pace) {
       // Feed at the sensor's rate: wait until this frame's time has come.

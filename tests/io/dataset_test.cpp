@@ -346,6 +346,22 @@ TEST(FramePrefetcher, DeliversEveryFrameInOrder) {
   EXPECT_FALSE(pf.next().has_value());  // stays at the end
 }
 
+TEST(FramePrefetcher, PreparesEveryFrameBeforeHandingItOver) {
+  TempDir dir;
+  make_tum(dir, 5);
+  const auto ds = open_dataset(dir.path(), tiny_settings());
+  FramePrefetcher pf(*ds, 2, 0, SIZE_MAX, [](RgbdFrame& f) { f.depth.setTo(1.25f); });
+  std::size_t n = 0;
+  while (auto f = pf.next()) {
+    double lo = 0, hi = 0;
+    cv::minMaxLoc(f->depth, &lo, &hi);
+    EXPECT_FLOAT_EQ(static_cast<float>(lo), 1.25f);
+    EXPECT_FLOAT_EQ(static_cast<float>(hi), 1.25f);
+    ++n;
+  }
+  EXPECT_EQ(n, 5u);
+}
+
 TEST(FramePrefetcher, HonoursFirstAndCount) {
   TempDir dir;
   make_tum(dir, 10);
