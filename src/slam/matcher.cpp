@@ -13,6 +13,36 @@ namespace {
 
 const std::uint8_t* row_ptr(const cv::Mat& m, int r) { return m.ptr<std::uint8_t>(r); }
 
+/// The two closest descriptors to a projected map point among the frame's candidate keypoints, with their levels.
+struct CandidateScore {
+  int best = std::numeric_limits<int>::max(), second = std::numeric_limits<int>::max();
+  int best_idx = -1, best_level = -1, second_level = -1;
+};
+
+/// Scores `cands` of `cur` against descriptor `d`, skipping keypoints already matched to a real map point and
+/// those whose measured depth disagrees with the predicted virtual right coordinate `ur_pred` by more than `r`.
+CandidateScore score_candidates(const Frame& cur, const std::vector<int>& cands, const cv::Mat& d, double ur_pred,
+                                double r) {
+  const FrameFeatures& F = *cur.features;
+  CandidateScore s;
+  for (int c : cands) {
+    if (cur.map_points[c] && cur.map_points[c]->num_observations() > 0) continue;
+    if (F.u_right[c] > 0 && std::abs(ur_pred - F.u_right[c]) > r) continue;
+    const int dd = descriptor_distance(d.ptr<std::uint8_t>(), row_ptr(F.descriptors, c));
+    if (dd < s.best) {
+      s.second = s.best;
+      s.second_level = s.best_level;
+      s.best = dd;
+      s.best_idx = c;
+      s.best_level = F.keypoints[c].octave;
+    } else if (dd < s.second) {
+      s.second = dd;
+      s.second_level = F.keypoints[c].octave;
+    }
+  }
+  return s;
+}
+
 /// Keeps only matches with a consistent rotation; `rot` collects (keypoint index, angle difference).
 void enforce_rotation_consistency(Frame& cur, const std::vector<std::pair<int, float>>& rot, int& n_matches) {
   if (rot.empty()) return;
@@ -60,18 +90,9 @@ int match_last_frame(Frame& cur, const Frame& last, double radius) {
     if (cands.empty()) continue;
     const cv::Mat d = mp->descriptor();
     if (d.empty()) continue;
-    const double ur_pred = uv.x() - F.camera.bf / pc.z();
-    int best = std::numeric_limits<int>::max(), best_idx = -1;
-    for (int c : cands) {
-      if (cur.map_points[c] && cur.map_points[c]->num_observations() > 0) continue;
-      if (F.u_right[c] > 0 && std::abs(ur_pred - F.u_right[c]) > r) continue;
-      const int dist = descriptor_distance(d.ptr<std::uint8_t>(), row_ptr(F.descriptors, c));
-      if (dist < best) {
-        best = dist;
-        best_idx = c;
-      }
-    }
-    if (best_idx >= 0 && best <= kDescDistHigh) {
+    const CandidateScore score = score_candidates(cur, cands, d, uv.x() - F.camera.bf / pc.z(), r);
+    const int best_idx = score.best_idx;
+    if (best_idx >= 0 && score.best <= kDescDistHigh) {
       if (!cur.map_points[best_idx]) ++n;
       cur.map_points[best_idx] = mp;
       cur.outlier[best_idx] = false;
@@ -108,23 +129,8 @@ int match_local_map(Frame& cur, const std::vector<MapPointPtr>& points, double r
     if (cands.empty()) continue;
     const cv::Mat d = mp->descriptor();
     if (d.empty()) continue;
-    const double ur_pred = uv.x() - F.camera.bf / pc.z();
-    int best = std::numeric_limits<int>::max(), second = best, best_idx = -1, best_level = -1, second_level = -1;
-    for (int c : cands) {
-      if (cur.map_points[c] && cur.map_points[c]->num_observations() > 0) continue;
-      if (F.u_right[c] > 0 && std::abs(ur_pred - F.u_right[c]) > r) continue;
-      const int dd = descriptor_distance(d.ptr<std::uint8_t>(), row_ptr(F.descriptors, c));
-      if (dd < best) {
-        second = best;
-        second_level = best_level;
-        best = dd;
-        best_idx = c;
-        best_level = F.keypoints[c].octave;
-      } else if (dd < second) {
-        second = dd;
-        second_level = F.keypoints[c].octave;
-      }
-    }
+    const auto [best, second, best_idx, best_level, second_level] =
+        score_candidates(cur, cands, d, uv.x() - F.camera.bf / pc.z(), r);
     if (best_idx < 0 || best > kDescDistHigh) continue;
     if (best_level == second_level && best > 0.8 * second) continue;  // ambiguous at the same scale
     if (!cur.map_points[best_idx]) ++n;
