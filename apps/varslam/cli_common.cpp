@@ -10,6 +10,9 @@
 namespace varslam::cli {
 
 void apply_overrides(Settings& settings, const std::vector<std::string>& overrides) {
+  if (overrides.empty()) return;
+  // Built-in defaults have no document yet: start from theirs, so camera/depth/ORB overrides apply too.
+  if (settings.source.empty()) settings.root = YAML::Load(settings_yaml(settings));
   for (const std::string& o : overrides) {
     const auto eq = o.find('=');
     const auto dot = o.find('.');
@@ -22,8 +25,8 @@ void apply_overrides(Settings& settings, const std::vector<std::string>& overrid
       throw ConfigError(fmt::format("--set '{}': settings key '{}' is not a section", o, section));
     settings.root[section][key] = YAML::Load(value);
   }
-  // Camera, depth and ORB fields were read when the file was loaded: read them again from the edited document.
-  if (!overrides.empty() && !settings.source.empty()) settings = settings_from_yaml(settings.root, settings.source);
+  // Camera, depth and ORB fields were read when the document was loaded: read them again from the edited one.
+  settings = settings_from_yaml(settings.root, settings.source);
 }
 
 void write_report_for_run(const std::filesystem::path& run_dir, const std::filesystem::path& sequence_dir) {

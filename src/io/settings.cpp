@@ -284,7 +284,7 @@ Settings settings_from_yaml(const YAML::Node& root, const std::filesystem::path&
   return s;
 }
 
-void save_settings(const Settings& s, const std::filesystem::path& file) {
+std::string settings_yaml(const Settings& s) {
   const auto& c = s.camera;
   std::string text = "# varslam settings (camera baseline in metres: bf = fx * baseline)\n";
   text += fmt::format(
@@ -311,7 +311,11 @@ void save_settings(const Settings& s, const std::filesystem::path& file) {
     e << YAML::EndMap;
     if (any) text += std::string(e.c_str()) + "\n";
   }
+  return text;
+}
 
+void save_settings(const Settings& s, const std::filesystem::path& file) {
+  const std::string text = settings_yaml(s);
   std::ofstream out(file);
   if (!out) throw ConfigError(fmt::format("{}: cannot write settings file", file.string()));
   out << text;

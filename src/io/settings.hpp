@@ -37,7 +37,8 @@ Settings load_settings(const std::filesystem::path& file);
 /// The same from a parsed document (`file` names it in errors): re-reads camera, depth and ORB fields after
 /// `--set` overrides edited the document.
 Settings settings_from_yaml(const YAML::Node& root, const std::filesystem::path& file);
-/// Write our own YAML layout (what `synth` puts next to a generated sequence).
+/// Our own YAML layout of `s` (what `synth` puts next to a generated sequence), and writing it to a file.
+std::string settings_yaml(const Settings& s);
 void save_settings(const Settings& s, const std::filesystem::path& file);
 
 /// Typed read of an optional key inside a section ("tracking.kernel" style dotted path); a wrong type is a

@@ -160,6 +160,20 @@ TEST(Settings, EditedDocumentIsReadAgainIncludingCameraDepthAndOrbFields) {
   EXPECT_EQ(r.source, file);
 }
 
+TEST(Settings, DefaultsAsADocumentReadBackTheSameAndTakeEdits) {
+  // What `--set` does when a dataset has no settings file: the built-in defaults become a document first.
+  Settings d = default_settings();
+  d.depth_factor = 1000.0;  // e.g. the OpenLORIS default
+  YAML::Node doc = YAML::Load(settings_yaml(d));
+  const Settings same = settings_from_yaml(doc, {});
+  EXPECT_DOUBLE_EQ(same.camera.fx, d.camera.fx);
+  EXPECT_DOUBLE_EQ(same.camera.bf, d.camera.bf);
+  EXPECT_DOUBLE_EQ(same.depth_factor, 1000.0);
+  EXPECT_EQ(same.orb.n_features, d.orb.n_features);
+  doc["orb"]["n_features"] = 300;
+  EXPECT_EQ(settings_from_yaml(doc, {}).orb.n_features, 300);
+}
+
 TEST(Settings, ReadsTheOlderOrbSlamLayoutWithOpenCvHeaderAndMatrixTags) {
   TempDir dir;
   const auto file = dir.write("TUM1.yaml", R"(%YAML:1.0
