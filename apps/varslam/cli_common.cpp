@@ -42,6 +42,9 @@ void print_run_summary(const slam::RunSummary& s) {
   fmt::print("tracked          {} ({:.1f}%), lost {}, map segments {}\n", s.tracked,
              s.frames ? 100.0 * s.tracked / s.frames : 0.0, s.lost, s.segments);
   fmt::print("map              {} keyframes, {} points\n", s.keyframes, s.map_points);
+  if (s.metrics.contains("loops") && s.metrics.contains("relocalizations"))
+    fmt::print("loops closed     {}, relocalizations {}\n", s.metrics["loops"].size(),
+               s.metrics["relocalizations"].get<int>());
   fmt::print("speed            {:.1f} frames/s over {:.1f} s\n", s.fps, s.wall_seconds);
   if (s.metrics.contains("timings")) {
     const auto& t = s.metrics["timings"];

@@ -80,6 +80,8 @@ std::string key_numbers_table(const nlohmann::json& m) {
   t += row("tracked frames", integer("tracked_frames"));
   t += row("lost frames", integer("lost_frames"));
   t += row("map segments", integer("map_segments"));
+  t += row("relocalizations", integer("relocalizations"));
+  t += row("loops closed", m.contains("loops") && m["loops"].is_array() ? std::to_string(m["loops"].size()) : "n/a");
   t += row("keyframes", integer("keyframes"));
   t += row("map points", integer("map_points"));
   t += row("ATE RMSE", cm(json_number(m, {"ate", "rmse"})));

@@ -108,6 +108,31 @@ SlamConfig slam_config_from(const Settings& s) {
   if (c.mapping.ba_outer_iterations < 1 || c.mapping.ba_iterations < 1)
     throw ConfigError(fmt::format("{}: mapping.ba_outer_iterations and mapping.ba_iterations must be >= 1",
                                   s.source.string()));
+
+  LoopConfig& l = c.loop;
+  l.enabled = setting_or<bool>(s, "loop.enabled", l.enabled);
+  l.min_keyframes = setting_or<int>(s, "loop.min_keyframes", l.min_keyframes);
+  l.min_keyframe_gap = setting_or<int>(s, "loop.min_keyframe_gap", l.min_keyframe_gap);
+  l.min_score = setting_or<int>(s, "loop.min_score", l.min_score);
+  l.candidates = static_cast<std::size_t>(setting_or<int>(s, "loop.candidates", static_cast<int>(l.candidates)));
+  l.min_ransac_inliers = setting_or<int>(s, "loop.min_ransac_inliers", l.min_ransac_inliers);
+  l.min_inliers = setting_or<int>(s, "loop.min_inliers", l.min_inliers);
+  l.keyframes_after_loop = setting_or<int>(s, "loop.keyframes_after_loop", l.keyframes_after_loop);
+  l.pose_graph_min_weight = setting_or<int>(s, "loop.pose_graph_min_weight", l.pose_graph_min_weight);
+  l.global_ba = setting_or<bool>(s, "loop.global_ba", l.global_ba);
+  l.global_ba_iterations = setting_or<int>(s, "loop.global_ba_iterations", l.global_ba_iterations);
+  l.final_global_ba = setting_or<bool>(s, "loop.final_global_ba", l.final_global_ba);
+  if (l.min_ransac_inliers < 3 || l.min_inliers < 3 || l.candidates < 1)
+    throw ConfigError(fmt::format("{}: loop.min_ransac_inliers and loop.min_inliers must be >= 3, loop.candidates >= 1",
+                                  s.source.string()));
+
+  RelocalizationConfig& r = c.relocalization;
+  r.enabled = setting_or<bool>(s, "relocalization.enabled", r.enabled);
+  r.min_score = setting_or<int>(s, "relocalization.min_score", r.min_score);
+  r.candidates = static_cast<std::size_t>(setting_or<int>(s, "relocalization.candidates", static_cast<int>(r.candidates)));
+  r.min_inliers = setting_or<int>(s, "relocalization.min_inliers", r.min_inliers);
+  if (r.min_inliers < 3)
+    throw ConfigError(fmt::format("{}: relocalization.min_inliers must be >= 3", s.source.string()));
   return c;
 }
 

@@ -42,11 +42,35 @@ struct MappingConfig {
   optim::LocalBaObserver ba_observer;  // debug/benchmark hook: sees every Local BA problem (empty: none)
 };
 
+struct LoopConfig {
+  bool enabled = true;
+  int min_keyframes = 10;       // keyframes in the map before loops are sought
+  int min_keyframe_gap = 10;    // a candidate is at least this many keyframe ids older than the query
+  int min_score = 40;           // signature matches (of 1000) for a place candidate
+  std::size_t candidates = 3;   // best place candidates verified per keyframe
+  int min_ransac_inliers = 25;  // 3-D/3-D RANSAC inliers against the candidate keyframe
+  int min_inliers = 80;         // pose inliers after guided matching against the candidate's neighbourhood
+  int keyframes_after_loop = 5; // keyframes skipped after a closure (the same loop is found again at once)
+  int pose_graph_min_weight = 100;  // covisibility weight for a pose-graph edge (besides the spanning tree)
+  bool global_ba = true;
+  int global_ba_iterations = 10;
+  bool final_global_ba = false;  // one global BA when the run ends
+};
+
+struct RelocalizationConfig {
+  bool enabled = true;
+  int min_score = 30;          // signature matches (of 1000) for a candidate keyframe
+  std::size_t candidates = 5;  // candidates tried per lost frame
+  int min_inliers = 30;        // pose inliers against the candidate keyframe
+};
+
 struct SlamConfig {
   OrbParams orb;
   ExtractorKind extractor = ExtractorKind::Ours;
   TrackingConfig tracking;
   MappingConfig mapping;
+  LoopConfig loop;
+  RelocalizationConfig relocalization;
   double fps = 30.0;
 };
 

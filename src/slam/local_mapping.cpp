@@ -9,6 +9,7 @@
 #include <set>
 
 #include "optim/local_ba.hpp"
+#include "slam/ba_problem_builder.hpp"
 #include "slam/matcher.hpp"
 
 namespace varslam::slam {
@@ -116,8 +117,11 @@ void LocalMapper::process(const KeyFramePtr& kf) {
     if (cfg_.cull_keyframes) cull_keyframes(kf);
   }
   remove_bad_from_map();
-  std::lock_guard lock(stats_mutex_);
-  stats_.keyframe_ms.push_back(ms_since(t0));
+  {
+    std::lock_guard lock(stats_mutex_);
+    stats_.keyframe_ms.push_back(ms_since(t0));
+  }
+  if (keyframe_done_) keyframe_done_(kf);
 }
 
 void LocalMapper::add_observations(const KeyFramePtr& kf) {
@@ -278,32 +282,12 @@ void LocalMapper::local_ba(const KeyFramePtr& kf) {
   }
   if (local.size() < 2 && fixed.empty()) return;  // nothing anchors the gauge yet
 
-  optim::BaProblem problem;
-  std::map<long, int> kf_index;
-  const auto add_kf = [&](const KeyFramePtr& k, bool is_fixed) {
-    kf_index[k->id()] = static_cast<int>(problem.keyframes.size());
-    // The first keyframe of the map anchors the gauge when it is in the window.
-    problem.keyframes.push_back({k->pose(), is_fixed || k->id() == 0});
-  };
-  for (const auto& k : local) add_kf(k, false);
-  for (const auto& k : fixed) add_kf(k, true);
-  std::vector<std::pair<KeyFramePtr, MapPointPtr>> obs_owner;
-  for (std::size_t p = 0; p < points.size(); ++p) {
-    problem.points.push_back(points[p]->position());
-    for (const auto& [k, idx] : points[p]->observations()) {
-      auto it = kf_index.find(k->id());
-      if (it == kf_index.end() || k->is_bad()) continue;
-      const FrameFeatures& F = k->features();
-      optim::BaObservation o;
-      o.keyframe = it->second;
-      o.point = static_cast<int>(p);
-      o.obs.uv = {F.keypoints[idx].pt.x, F.keypoints[idx].pt.y};
-      o.obs.u_right = F.u_right[idx];
-      o.obs.inv_sigma2 = scale_->inv_level_sigma2[F.keypoints[idx].octave];
-      problem.observations.push_back(o);
-      obs_owner.emplace_back(k, points[p]);
-    }
-  }
+  BaProblemBuilder ba;
+  // The first keyframe of the map anchors the gauge when it is in the window.
+  for (const auto& k : local) ba.add_keyframe(k, k->id() == 0);
+  for (const auto& k : fixed) ba.add_keyframe(k, true);
+  for (const auto& mp : points) ba.add_point(mp);
+  optim::BaProblem& problem = ba.problem;
   bool any_free = false;
   for (const auto& k : problem.keyframes) any_free |= !k.fixed;
   if (!any_free || problem.observations.empty()) return;
@@ -321,17 +305,8 @@ void LocalMapper::local_ba(const KeyFramePtr& kf) {
   {
     // Write back under the map's update lock: tracking never sees a half-updated window.
     std::unique_lock lock(map_.update_mutex());
-    for (std::size_t i = 0; i < local.size(); ++i)
-      if (!problem.keyframes[i].fixed) local[i]->set_pose(problem.keyframes[i].T_cw);
-    for (std::size_t p = 0; p < points.size(); ++p) points[p]->set_position(problem.points[p]);
-    for (std::size_t o = 0; o < res.outlier_observation.size(); ++o) {
-      if (!res.outlier_observation[o]) continue;
-      const auto& [k, mp] = obs_owner[o];
-      const int idx = mp->index_in(k.get());
-      if (idx >= 0) k->erase_map_point(idx);
-      mp->erase_observation(k);
-      ++outliers;
-    }
+    ba.write_back();
+    outliers = ba.erase_outliers(res.outlier_observation);
   }
   for (const auto& mp : points)
     if (!mp->is_bad()) mp->update_normal_and_depth(scale_->scale_factors);

@@ -4,6 +4,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <deque>
+#include <functional>
 #include <list>
 #include <mutex>
 #include <thread>
@@ -54,6 +55,9 @@ class LocalMapper final : public KeyframeSink {
 
   MappingStats stats() const;
 
+  /// Called in the mapping thread after each keyframe is processed (loop closing plugs in here).
+  void set_keyframe_done(std::function<void(const KeyFramePtr&)> fn) { keyframe_done_ = std::move(fn); }
+
  private:
   void run();
   void process(const KeyFramePtr& kf);
@@ -78,6 +82,7 @@ class LocalMapper final : public KeyframeSink {
   std::atomic<bool> stop_requested_{false};
   std::thread thread_;
 
+  std::function<void(const KeyFramePtr&)> keyframe_done_;
   std::list<MapPointPtr> recent_points_;
   mutable std::mutex stats_mutex_;
   MappingStats stats_;

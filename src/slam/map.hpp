@@ -34,6 +34,10 @@ class Map {
 
   std::shared_mutex& update_mutex() { return update_mutex_; }
 
+  /// Counts map-wide corrections (loop closures): tracking re-anchors its last frame when it changes.
+  long corrections() const { return corrections_.load(); }
+  void note_correction() { corrections_.fetch_add(1); }
+
  private:
   mutable std::mutex mutex_;
   std::set<KeyFramePtr, IdLess> keyframes_;
@@ -41,6 +45,7 @@ class Map {
   std::atomic<long> next_kf_id_{0};
   std::atomic<long> next_mp_id_{0};
   std::shared_mutex update_mutex_;
+  std::atomic<long> corrections_{0};
 };
 
 }  // namespace varslam::slam

@@ -17,8 +17,10 @@ inline constexpr int kDescDistLow = 50;    // strict distance for fusing and tri
 int match_last_frame(Frame& cur, const Frame& last, double radius);
 
 /// Projects local map points into `cur` (frustum and viewing-angle checks, scale prediction) and matches the
-/// ones not matched yet. Marks visited points visible. `radius_scale` widens the search (e.g. after a loss).
-int match_local_map(Frame& cur, const std::vector<MapPointPtr>& points, double radius_scale);
+/// ones not matched yet. Marks visited points visible (unless `count_visible` is false: a check that is not
+/// tracking, like loop verification, must not touch the points' tracking statistics). `radius_scale` widens the
+/// search (e.g. after a loss).
+int match_local_map(Frame& cur, const std::vector<MapPointPtr>& points, double radius_scale, bool count_visible = true);
 
 /// Descriptor matching of the keyframe's map points against all of the frame's keypoints (ratio test,
 /// rotation consistency); the fallback when the motion model fails.

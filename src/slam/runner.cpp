@@ -197,6 +197,7 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const Slam
   m["lost_frames"] = sum.lost;
   m["tracked_share"] = sum.frames ? static_cast<double>(sum.tracked) / sum.frames : 0.0;
   m["map_segments"] = sum.segments;
+  m["relocalizations"] = system.tracker().relocalizations();
   m["keyframes"] = sum.keyframes;
   m["map_points"] = sum.map_points;
   m["triangulated_points"] = ms.triangulated_points;
@@ -208,8 +209,17 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const Slam
   m["timings"] = {{"load", timing_json(load)},       {"extract", timing_json(extract)},
                   {"filter", timing_json(filt)},     {"match", timing_json(match)},
                   {"pose_optimization", timing_json(pose)}, {"tracking", timing_json(track)},
-                  {"keyframe_processing", timing_json(kf_ms)}, {"local_ba", timing_json(ba_ms)}};
+                  {"keyframe_processing", timing_json(kf_ms)}, {"local_ba", timing_json(ba_ms)},
+                  {"loop_detection", timing_json(system.loop_detection_ms())}};
   m["local_ba"] = ba_json;
+  nlohmann::json loops = nlohmann::json::array();
+  for (const LoopRecord& l : system.loops())
+    loops.push_back({{"keyframe", l.query_keyframe}, {"loop_keyframe", l.loop_keyframe}, {"timestamp", l.timestamp},
+                     {"place_score", l.score}, {"ransac_inliers", l.ransac_inliers}, {"inliers", l.inliers},
+                     {"fused_points", l.fused_points}, {"correction_m", l.correction_m},
+                     {"correction_deg", l.correction_deg}, {"pose_graph_ms", l.pose_graph_ms},
+                     {"global_ba_ms", l.global_ba_ms}, {"total_ms", l.total_ms}});
+  m["loops"] = loops;
   m["keypoints_per_frame"] = count_json(n_kps);
   m["depth_edge_rejected_per_frame"] = count_json(edge_rejected);
   if (masker) {

@@ -6,7 +6,10 @@ System::System(const SlamConfig& cfg, const PinholeCamera& camera, double close_
     // The tracker only stores its keyframe sink here; the mapper takes the pyramid facts from the tracker's
     // extractor, so both stages use one ScaleInfo.
     : cfg_(cfg), mode_(mode), tracker_(cfg, camera, close_depth, map_, mapper_),
-      mapper_(cfg.mapping, map_, tracker_.scale(), close_depth) {
+      mapper_(cfg.mapping, map_, tracker_.scale(), close_depth),
+      loop_(cfg.loop, cfg.tracking.kernel, map_, places_, tracker_.scale()) {
+  tracker_.set_place_database(&places_);
+  mapper_.set_keyframe_done([this](const KeyFramePtr& kf) { loop_.process(kf); });
   if (mode_ == RunMode::RealTime) mapper_.start();
 }
 
@@ -21,7 +24,10 @@ TrackOutcome System::process(const RgbdFrame& frame) {
   return out;
 }
 
-void System::finish() { mapper_.stop(); }
+void System::finish() {
+  mapper_.stop();
+  if (cfg_.loop.final_global_ba) loop_.run_global_ba();
+}
 
 Trajectory System::camera_trajectory(bool include_lost) const {
   Trajectory traj;

@@ -1,13 +1,15 @@
 #pragma once
 // The SLAM system: wires tracking and local mapping, in one of two modes.
 //  - deterministic: stages run in order in the caller's thread (same input, same output);
-//  - real-time: local mapping on its own thread, frames decoded ahead by the prefetcher, tracking in the
+//  - real-time: local mapping (then loop closing) on its own thread, frames decoded ahead by the prefetcher, tracking in the
 //    caller's thread, optionally paced at the dataset's frame rate.
 #include <memory>
 #include <vector>
 
 #include "core/trajectory.hpp"
+#include "slam/keyframe_database.hpp"
 #include "slam/local_mapping.hpp"
+#include "slam/loop_closing.hpp"
 #include "slam/tracking.hpp"
 
 namespace varslam::slam {
@@ -45,14 +47,18 @@ class System {
   Map& map() { return map_; }
   const Tracker& tracker() const { return tracker_; }
   MappingStats mapping_stats() const { return mapper_.stats(); }
+  std::vector<LoopRecord> loops() const { return loop_.loops(); }
+  std::vector<double> loop_detection_ms() const { return loop_.detection_ms(); }
   RunMode mode() const { return mode_; }
 
  private:
   SlamConfig cfg_;
   RunMode mode_;
   Map map_;
-  Tracker tracker_;     // constructed first: the mapper takes its ScaleInfo
+  KeyframeDatabase places_;  // filled by loop closing, read by relocalization
+  Tracker tracker_;     // constructed before the mapper and loop closer: they take its ScaleInfo
   LocalMapper mapper_;
+  LoopCloser loop_;
 };
 
 }  // namespace varslam::slam

@@ -10,6 +10,7 @@
 #include "slam/config.hpp"
 #include "slam/frame.hpp"
 #include "slam/keyframe.hpp"
+#include "slam/keyframe_database.hpp"
 #include "slam/map.hpp"
 
 namespace varslam::slam {
@@ -57,11 +58,14 @@ class Tracker {
 
   TrackOutcome track(const RgbdFrame& input);
   void set_keypoint_filter(KeypointFilterFn fn) { filter_ = std::move(fn); }
+  /// Keyframes to relocalize against when tracking is lost (none: only the last reference's neighbourhood).
+  void set_place_database(const KeyframeDatabase* places) { places_ = places; }
 
   TrackState state() const { return state_; }
   const std::vector<FrameRecord>& records() const { return records_; }
   const Frame& last_frame() const { return last_; }
   int segments() const { return segments_; }
+  int relocalizations() const { return relocalizations_; }
   std::shared_ptr<const ScaleInfo> scale() const { return scale_; }
 
  private:
@@ -74,6 +78,8 @@ class Tracker {
   int track_motion_model(Frame& cur, FrameTimings& t, int* matches);
   int track_reference_keyframe(Frame& cur, const KeyFramePtr& kf, FrameTimings& t);
   bool recover(Frame& cur, FrameTimings& t);
+  /// Global relocalization: place candidates from the database, each located by descriptor matches + RANSAC.
+  bool relocalize(Frame& cur, FrameTimings& t);
   bool track_local_map(Frame& cur, FrameTimings& t);
   int optimize_and_discard(Frame& cur, FrameTimings& t);
   void update_local_map(Frame& cur);
@@ -91,6 +97,7 @@ class Tracker {
   std::unique_ptr<FeatureExtractor> extractor_;
   std::shared_ptr<const ScaleInfo> scale_;
   KeypointFilterFn filter_;
+  const KeyframeDatabase* places_ = nullptr;
 
   TrackState state_ = TrackState::NotInitialized;
   long next_frame_id_ = 0;
@@ -104,6 +111,8 @@ class Tracker {
   long last_recovery_frame_id_ = -1000;
   int lost_count_ = 0;
   int segments_ = 0;
+  int relocalizations_ = 0;
+  long seen_corrections_ = 0;  // map_.corrections() when the last frame was last re-anchored
   std::vector<KeyFramePtr> local_keyframes_;
   std::vector<MapPointPtr> local_points_;
   std::vector<FrameRecord> records_;

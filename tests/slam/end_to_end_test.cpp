@@ -9,14 +9,14 @@
 #include <string>
 #include <unistd.h>
 
-#include "io/dataset.hpp"
-#include "slam/runner.hpp"
-#include "synth/synth.hpp"
+#include "e2e_support.hpp"
 
 namespace varslam::slam {
 namespace {
 
 namespace fs = std::filesystem;
+using e2e::cached_sequence;
+using e2e::run_on;
 
 std::string slurp(const fs::path& p) {
   std::ifstream in(p);
@@ -31,23 +31,6 @@ fs::path test_dir(const std::string& name) {
   return d;
 }
 
-// Synthetic sequences shared by the tests of this file (generation is the slow part), cached per generator
-// version. ctest runs each test in its own process, possibly in parallel: generate into a private folder, then
-// rename it into place.
-fs::path cached_sequence(const std::string& name, synth::SynthConfig cfg) {
-  const fs::path d =
-      fs::temp_directory_path() / ("varslam_e2e_" + name + "_g" + std::to_string(synth::kGeneratorVersion));
-  if (fs::exists(d / "groundtruth.txt")) return d;
-  const fs::path tmp = fs::temp_directory_path() / ("varslam_e2e_tmp_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(tmp);
-  cfg.preview = false;
-  synth::generate(cfg, tmp);
-  std::error_code ec;
-  fs::rename(tmp, d, ec);
-  if (ec) fs::remove_all(tmp);  // another process won the race: its copy is identical
-  return d;
-}
-
 const fs::path& static_sequence() {
   static const fs::path dir = [] {
     synth::SynthConfig cfg;
@@ -57,19 +40,6 @@ const fs::path& static_sequence() {
     return cached_sequence("static_seq", cfg);
   }();
   return dir;
-}
-
-RunSummary run_on(const fs::path& data, const fs::path& out, RunMode mode, std::size_t max_frames = SIZE_MAX,
-                  const std::function<void(SlamConfig&)>& adjust = {}) {
-  Settings settings = settings_for_dataset(data, std::nullopt);
-  SlamConfig cfg = slam_config_from(settings);
-  if (adjust) adjust(cfg);
-  auto ds = open_dataset(data, settings);
-  RunOptions ro;
-  ro.mode = mode;
-  ro.progress = false;
-  ro.max_frames = max_frames;
-  return run_slam(*ds, settings, cfg, ro, out);
 }
 
 TEST(EndToEnd, StaticSyntheticSceneIsTrackedAccurately) {

@@ -1,0 +1,82 @@
+#include "slam/keyframe_localization.hpp"
+
+#include "optim/pose_optimizer.hpp"
+#include "optim/rigid_alignment.hpp"
+#include "slam/ba_problem_builder.hpp"
+#include "slam/matcher.hpp"
+
+namespace varslam::slam {
+
+int refine_pose_on_matches(Frame& cur, const optim::KernelConfig& kernel) {
+  const FrameFeatures& F = *cur.features;
+  std::vector<Eigen::Vector3d> pts;
+  std::vector<optim::Observation> obs;
+  std::vector<int> idx;
+  for (std::size_t i = 0; i < cur.map_points.size(); ++i) {
+    const MapPointPtr& mp = cur.map_points[i];
+    if (!mp || mp->is_bad()) {
+      cur.map_points[i].reset();
+      continue;
+    }
+    pts.push_back(mp->position());
+    obs.push_back(keypoint_observation(F, i));
+    idx.push_back(static_cast<int>(i));
+  }
+  if (obs.size() < 3) return 0;
+  optim::PoseOptimConfig pc;
+  pc.kernel = kernel;
+  pc.solver = optim::PoseSolver::Dedicated;
+  const auto res = optim::optimize_pose(F.camera, cur.T_cw, pts, obs, pc);
+  int inliers = 0;
+  for (std::size_t k = 0; k < idx.size(); ++k) {
+    cur.outlier[idx[k]] = false;
+    if (res.outlier[k]) cur.map_points[idx[k]].reset();
+    else ++inliers;
+  }
+  cur.has_pose = true;
+  return inliers;
+}
+
+int locate_against_keyframe(Frame& cur, const KeyFrame& kf, const LocalizationConfig& cfg) {
+  const Eigen::Isometry3d prior = cur.T_cw;
+  const auto fail = [&] {
+    std::fill(cur.map_points.begin(), cur.map_points.end(), nullptr);
+    std::fill(cur.outlier.begin(), cur.outlier.end(), false);
+    cur.T_cw = prior;
+    return 0;
+  };
+  std::fill(cur.map_points.begin(), cur.map_points.end(), nullptr);
+  if (match_keyframe_by_descriptor(cur, kf) < cfg.min_matches) return fail();
+
+  // World points of the matches against the keypoints' own camera-frame points (where depth is valid).
+  const FrameFeatures& F = *cur.features;
+  std::vector<Eigen::Vector3d> world, camera;
+  std::vector<double> tolerance;
+  std::vector<int> idx;
+  for (std::size_t i = 0; i < cur.map_points.size(); ++i) {
+    const MapPointPtr& mp = cur.map_points[i];
+    if (!mp || mp->is_bad() || !F.has_depth(i)) continue;
+    world.push_back(mp->position());
+    camera.push_back(F.unproject(i));
+    const double z = F.depth[i];
+    tolerance.push_back(cfg.tolerance_base + cfg.tolerance_per_m2 * z * z);
+    idx.push_back(static_cast<int>(i));
+  }
+  if (static_cast<int>(world.size()) < cfg.min_inliers) return fail();
+  optim::RigidRansacConfig rc;
+  rc.iterations = cfg.ransac_iterations;
+  rc.min_inliers = cfg.min_inliers;
+  rc.seed = static_cast<std::uint64_t>(kf.id()) + 1;
+  const optim::RigidRansacResult r = optim::estimate_rigid_ransac(world, camera, rc, &tolerance);
+  if (!r.ok) return fail();
+  // T_ab maps camera points to world points: it is the camera-to-world pose.
+  cur.T_cw = r.T_ab.inverse();
+  // Keep only RANSAC inliers among the depth matches; matches without depth stay for the optimiser to judge.
+  for (std::size_t k = 0; k < idx.size(); ++k)
+    if (!r.inlier[k]) cur.map_points[idx[k]].reset();
+  const int inliers = refine_pose_on_matches(cur, cfg.kernel);
+  if (inliers < cfg.min_inliers) return fail();
+  return inliers;
+}
+
+}  // namespace varslam::slam

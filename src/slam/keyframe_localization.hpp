@@ -1,0 +1,28 @@
+#pragma once
+// Locating a frame against one keyframe with no pose prior (relocalization, loop verification): descriptor
+// matches to the keyframe's map points, a rigid 3-D/3-D RANSAC on the keypoints that have depth (RGB-D gives
+// metric points, so three matches fix a pose), then pose-only optimisation on all matches.
+#include "optim/kernel.hpp"
+#include "slam/frame.hpp"
+#include "slam/keyframe.hpp"
+
+namespace varslam::slam {
+
+struct LocalizationConfig {
+  int min_matches = 20;          // descriptor matches needed to try RANSAC
+  int min_inliers = 20;          // after RANSAC and after pose optimisation
+  int ransac_iterations = 200;
+  // Depth noise grows with the square of depth: a match is a RANSAC inlier within base + per_m2 * z^2 metres.
+  double tolerance_base = 0.02, tolerance_per_m2 = 0.01;
+  optim::KernelConfig kernel;  // pose refinement
+};
+
+/// On success sets cur.T_cw and cur.map_points (inliers only, outlier flags cleared) and returns the number of
+/// inliers; otherwise clears cur.map_points, leaves cur.T_cw as it was and returns 0.
+int locate_against_keyframe(Frame& cur, const KeyFrame& kf, const LocalizationConfig& cfg);
+
+/// Pose-only optimisation of cur.T_cw on its current matches (outliers dropped from cur.map_points); returns the
+/// inliers. Shared by relocalization and loop verification.
+int refine_pose_on_matches(Frame& cur, const optim::KernelConfig& kernel);
+
+}  // namespace varslam::slam

@@ -1,0 +1,72 @@
+#pragma once
+// Loop closing: after local mapping has processed a keyframe, look for an older place it sees again, verify it
+// geometrically, and correct the drift: rigid correction of the keyframe's neighbourhood, fusion of the
+// duplicated points, pose-graph optimisation of every keyframe (SE(3): depth fixes the scale), then a global
+// bundle adjustment. Runs in the thread that calls process() (local mapping's), so mapping is paused meanwhile;
+// tracking goes on and sees the corrections through the map's update lock.
+#include <mutex>
+#include <utility>
+#include <vector>
+
+#include "slam/config.hpp"
+#include "slam/keyframe_database.hpp"
+#include "slam/map.hpp"
+
+namespace varslam::slam {
+
+/// One closed loop (for the run's metrics).
+struct LoopRecord {
+  long query_keyframe = 0, loop_keyframe = 0;
+  double timestamp = 0;
+  int score = 0, ransac_inliers = 0, inliers = 0, fused_points = 0;
+  double correction_m = 0, correction_deg = 0;  // how far the query keyframe moved
+  double pose_graph_ms = 0, global_ba_ms = 0, total_ms = 0;
+};
+
+class LoopCloser {
+ public:
+  LoopCloser(const LoopConfig& cfg, const optim::KernelConfig& pose_kernel, Map& map, KeyframeDatabase& places,
+             std::shared_ptr<const ScaleInfo> scale);
+
+  /// Adds the keyframe to the place database, then looks for and closes a loop; true when one was closed.
+  bool process(const KeyFramePtr& kf);
+
+  std::vector<LoopRecord> loops() const;
+  /// Milliseconds spent looking for a loop (place query and verification), per keyframe processed.
+  std::vector<double> detection_ms() const;
+
+  /// Bundle adjustment of the whole map (Huber); returns its milliseconds.
+  double run_global_ba();
+
+ private:
+  struct Detection {
+    KeyFramePtr loop_kf;
+    int score = 0, ransac_inliers = 0, inliers = 0;
+    Eigen::Isometry3d T_cw_corrected;  // the query keyframe's pose in the loop's frame
+    std::vector<MapPointPtr> matches;  // per keypoint of the query keyframe: the loop-side point (or null)
+    std::vector<MapPointPtr> loop_points;  // the loop keyframe's neighbourhood
+  };
+  std::optional<Detection> detect(const KeyFramePtr& kf);
+  bool verify(const KeyFramePtr& kf, const PlaceCandidate& cand, Detection& out) const;
+  void correct(const KeyFramePtr& kf, Detection& det, LoopRecord& rec);
+  void optimize_pose_graph(const KeyFramePtr& kf, const std::vector<std::pair<KeyFramePtr, KeyFramePtr>>& new_links,
+                           const std::map<long, Eigen::Isometry3d>& uncorrected, LoopRecord& rec);
+  void global_bundle_adjustment(const KeyFramePtr& kf, LoopRecord& rec);
+  /// Moves keyframes and points from `before` to the keyframes' current poses; keyframes and points created
+  /// meanwhile (not in `before`) follow `anchor`. Call under the map's update lock.
+  void propagate(const std::map<long, Eigen::Isometry3d>& before, const KeyFramePtr& anchor,
+                 const Eigen::Isometry3d& anchor_before);
+
+  LoopConfig cfg_;
+  optim::KernelConfig pose_kernel_;
+  Map& map_;
+  KeyframeDatabase& places_;
+  std::shared_ptr<const ScaleInfo> scale_;
+  long last_loop_kf_ = -1000000;
+  std::vector<std::pair<KeyFramePtr, KeyFramePtr>> loop_links_;  // every loop edge so far (stays in the graph)
+  mutable std::mutex records_mutex_;
+  std::vector<LoopRecord> records_;
+  std::vector<double> detection_ms_;
+};
+
+}  // namespace varslam::slam

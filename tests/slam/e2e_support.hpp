@@ -1,0 +1,47 @@
+#pragma once
+// Shared by the end-to-end tests: cached synthetic sequences and one call that runs the pipeline on a folder.
+#include <unistd.h>
+
+#include <filesystem>
+#include <functional>
+#include <string>
+
+#include "io/dataset.hpp"
+#include "slam/runner.hpp"
+#include "synth/synth.hpp"
+
+namespace varslam::slam::e2e {
+
+namespace fs = std::filesystem;
+
+// Generation is the slow part, so sequences are cached per generator version. ctest runs each test in its own
+// process, possibly in parallel: generate into a private folder, then rename it into place.
+inline fs::path cached_sequence(const std::string& name, synth::SynthConfig cfg) {
+  const fs::path d =
+      fs::temp_directory_path() / ("varslam_e2e_" + name + "_g" + std::to_string(synth::kGeneratorVersion));
+  if (fs::exists(d / "groundtruth.txt")) return d;
+  const fs::path tmp = fs::temp_directory_path() / ("varslam_e2e_tmp_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(tmp);
+  cfg.preview = false;
+  synth::generate(cfg, tmp);
+  std::error_code ec;
+  fs::rename(tmp, d, ec);
+  if (ec) fs::remove_all(tmp);  // another process won the race: its copy is identical
+  return d;
+}
+
+/// Runs SLAM with the dataset's settings (adjusted by `adjust`) and writes into `out`.
+inline RunSummary run_on(const fs::path& data, const fs::path& out, RunMode mode = RunMode::Deterministic,
+                         std::size_t max_frames = SIZE_MAX, const std::function<void(SlamConfig&)>& adjust = {}) {
+  Settings settings = settings_for_dataset(data, std::nullopt);
+  SlamConfig cfg = slam_config_from(settings);
+  if (adjust) adjust(cfg);
+  auto ds = open_dataset(data, settings);
+  RunOptions ro;
+  ro.mode = mode;
+  ro.progress = false;
+  ro.max_frames = max_frames;
+  return run_slam(*ds, settings, cfg, ro, out);
+}
+
+}  // namespace varslam::slam::e2e
