@@ -103,4 +103,13 @@ int Frame::num_tracked() const {
   return n;
 }
 
+int Frame::num_established(int min_found) const {
+  int n = 0;
+  for (std::size_t i = 0; i < map_points.size(); ++i) {
+    const MapPointPtr& mp = map_points[i];
+    if (mp && !outlier[i] && !mp->is_bad() && mp->num_observations() > 0 && mp->found() >= min_found) ++n;
+  }
+  return n;
+}
+
 }  // namespace varslam::slam

@@ -237,7 +237,14 @@ bool Tracker::track_initial_pose(Frame& cur, FrameTimings& t) {
   if (!doubtful) return true;
   Frame by_motion = cur;
   const int by_keyframe = track_reference_keyframe(cur, reference_kf_, t);
-  if (by_keyframe >= kMinInliersMotion && by_keyframe >= inliers) {
+  // Compare on established points where they exist: a keyframe just made while a large mover came into view
+  // holds the mover's points, and matching it would lock the pose onto the mover (synthetic obstructing box).
+  const int min_found = cfg_.tracking.established_found;
+  const bool judge_established = min_found > 0 && by_motion.num_established(min_found) >= kMinEstablished;
+  const bool keyframe_wins = judge_established
+                                 ? cur.num_established(min_found) >= by_motion.num_established(min_found)
+                                 : by_keyframe >= inliers;
+  if (by_keyframe >= kMinInliersMotion && keyframe_wins) {
     spdlog::debug("frame {}: motion model doubtful ({} of {} matches), reference keyframe gives {} inliers", cur.id,
                   inliers, matches, by_keyframe);
     return true;
