@@ -46,7 +46,7 @@ struct LoopConfig {
   bool enabled = true;
   int min_keyframes = 10;       // keyframes in the map before loops are sought
   int min_keyframe_gap = 10;    // a candidate is at least this many keyframe ids older than the query
-  int min_score = 40;           // signature matches (of 1000) for a place candidate
+  int min_score = 30;           // signature matches (of 256) for a place candidate
   std::size_t candidates = 3;   // best place candidates verified per keyframe
   int min_ransac_inliers = 25;  // 3-D/3-D RANSAC inliers against the candidate keyframe
   int min_inliers = 80;         // pose inliers after guided matching against the candidate's neighbourhood
@@ -59,7 +59,7 @@ struct LoopConfig {
 
 struct RelocalizationConfig {
   bool enabled = true;
-  int min_score = 30;          // signature matches (of 1000) for a candidate keyframe
+  int min_score = 25;          // signature matches (of 256) for a candidate keyframe
   std::size_t candidates = 5;  // candidates tried per lost frame
   int min_inliers = 30;        // pose inliers against the candidate keyframe
 };
