@@ -88,6 +88,7 @@ SlamConfig slam_config_from(const Settings& s) {
   c.tracking.motion_inlier_ratio =
       setting_or<double>(s, "tracking.motion_inlier_ratio", c.tracking.motion_inlier_ratio);
   c.tracking.established_found = setting_or<int>(s, "tracking.established_found", c.tracking.established_found);
+  c.tracking.established_age = setting_or<int>(s, "tracking.established_age", c.tracking.established_age);
   c.tracking.min_inliers_local_map = setting_or<int>(s, "tracking.min_inliers", c.tracking.min_inliers_local_map);
   c.tracking.depth_edge_ratio = setting_or<double>(s, "depth.edge_ratio", c.tracking.depth_edge_ratio);
   c.tracking.depth_rig = read_depth_rig(s);

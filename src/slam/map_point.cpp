@@ -9,7 +9,8 @@
 namespace varslam::slam {
 
 MapPoint::MapPoint(long id, const Eigen::Vector3d& position, const std::shared_ptr<KeyFrame>& reference)
-    : id_(id), first_kf_id_(reference ? reference->id() : -1), position_(position), reference_(reference) {}
+    : id_(id), first_kf_id_(reference ? reference->id() : -1), first_frame_id_(reference ? reference->frame_id() : -1),
+      position_(position), reference_(reference) {}
 
 Eigen::Vector3d MapPoint::position() const {
   std::lock_guard lock(mutex_);

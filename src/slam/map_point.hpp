@@ -23,6 +23,7 @@ class MapPoint {
 
   long id() const { return id_; }
   long first_keyframe_id() const { return first_kf_id_; }
+  long first_frame_id() const { return first_frame_id_; }  // frame of the keyframe that created it
 
   Eigen::Vector3d position() const;
   void set_position(const Eigen::Vector3d& p);
@@ -75,6 +76,7 @@ class MapPoint {
 
   const long id_;
   const long first_kf_id_;
+  const long first_frame_id_;
   mutable std::mutex mutex_;
   Eigen::Vector3d position_;
   Eigen::Vector3d normal_ = Eigen::Vector3d::Zero();

@@ -206,7 +206,8 @@ int Tracker::optimize_and_discard(Frame& cur, FrameTimings& t) {
   int established = 0;
   for (std::size_t k = 0; k < idx.size(); ++k) {
     const MapPointPtr& mp = cur.map_points[idx[k]];
-    young[k] = mp->num_observations() == 0 || mp->found() < cfg_.tracking.established_found;
+    young[k] = mp->num_observations() == 0 || mp->found() < cfg_.tracking.established_found ||
+               cur.id - mp->first_frame_id() < cfg_.tracking.established_age;
     established += !young[k];
   }
   const bool trust_established = cfg_.tracking.established_found > 0 && established >= kMinEstablished;
