@@ -1,6 +1,8 @@
 #pragma once
 // Turns keyframes and map points into the plain optimiser problem (optim::BaProblem) and applies what the
 // optimiser found back to the map; shared by Local BA and global BA.
+#include <map>
+#include <utility>
 #include <vector>
 
 #include "optim/local_ba.hpp"

@@ -4,7 +4,10 @@
 // duplicated points, pose-graph optimisation of every keyframe (SE(3): depth fixes the scale), then a global
 // bundle adjustment. Runs in the thread that calls process() (local mapping's), so mapping is paused meanwhile;
 // tracking goes on and sees the corrections through the map's update lock.
+#include <map>
+#include <memory>
 #include <mutex>
+#include <optional>
 #include <utility>
 #include <vector>
 
