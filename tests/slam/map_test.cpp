@@ -137,5 +137,26 @@ TEST(Frame, DepthEdgeTestFlagsDiscontinuitiesOnly) {
   EXPECT_FALSE(on_depth_edge(depth, 31, 30, 4.0f, 0.1));
 }
 
+// The motion-model cross-check compares frames by established inliers: map points (not temporary ones) found in
+// enough frames, and not flagged as outliers in this frame.
+TEST(Map, EstablishedCountSkipsYoungTemporaryAndOutlierPoints) {
+  SmallMap m;
+  build(m, 6);
+  Frame f = frame_with_points(10, 6);
+  for (int i = 0; i < 5; ++i) f.map_points[i] = m.points[i];
+  m.points[0]->increase_found(3);  // found 4 times (counters start at 1)
+  m.points[1]->increase_found(3);
+  m.points[2]->increase_found(3);
+  f.outlier[2] = true;             // established but an outlier here
+  m.points[3]->increase_found(1);  // found twice: young
+  auto temporary = std::make_shared<MapPoint>(-1, Eigen::Vector3d(0, 0, 2), nullptr);
+  temporary->increase_found(10);   // no observation: a depth point of the last frame, never established
+  f.map_points[5] = temporary;
+  EXPECT_EQ(f.num_established(3), 2);
+  EXPECT_EQ(f.num_established(2), 3);
+  EXPECT_EQ(f.num_established(5), 0);
+  m.map.clear();
+}
+
 }  // namespace
 }  // namespace varslam::slam
