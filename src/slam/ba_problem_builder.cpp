@@ -10,6 +10,17 @@ optim::Observation keypoint_observation(const FrameFeatures& f, std::size_t i) {
   return o;
 }
 
+FramePoseProblem frame_pose_problem(const Frame& f) {
+  FramePoseProblem p;
+  for (std::size_t i = 0; i < f.map_points.size(); ++i) {
+    if (!f.map_points[i]) continue;
+    p.points.push_back(f.map_points[i]->position());
+    p.observations.push_back(keypoint_observation(*f.features, i));
+    p.keypoints.push_back(static_cast<int>(i));
+  }
+  return p;
+}
+
 void BaProblemBuilder::add_keyframe(const KeyFramePtr& kf, bool fixed) {
   index_of_[kf->id()] = static_cast<int>(problem.keyframes.size());
   problem.keyframes.push_back({kf->pose(), fixed});

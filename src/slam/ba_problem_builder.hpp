@@ -1,6 +1,7 @@
 #pragma once
-// Turns keyframes and map points into the plain optimiser problem (optim::BaProblem) and applies what the
-// optimiser found back to the map; shared by Local BA and global BA.
+// Turns map data into the plain optimiser problems: a frame's matches into a pose-only problem (tracking,
+// relocalization, loop verification), keyframes and points into optim::BaProblem (Local and global BA), and
+// applies what bundle adjustment found back to the map.
 #include <map>
 #include <utility>
 #include <vector>
@@ -12,6 +13,14 @@ namespace varslam::slam {
 
 /// The observation of keypoint i of a keyframe or frame, as the optimisers take it.
 optim::Observation keypoint_observation(const FrameFeatures& f, std::size_t i);
+
+/// A frame's matches as a pose-only problem: every matched map point, its observation, and the keypoint index.
+struct FramePoseProblem {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<optim::Observation> observations;
+  std::vector<int> keypoints;
+};
+FramePoseProblem frame_pose_problem(const Frame& f);
 
 struct BaProblemBuilder {
   optim::BaProblem problem;

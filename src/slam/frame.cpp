@@ -107,7 +107,7 @@ int Frame::num_established(int min_found) const {
   int n = 0;
   for (std::size_t i = 0; i < map_points.size(); ++i) {
     const MapPointPtr& mp = map_points[i];
-    if (mp && !outlier[i] && !mp->is_bad() && mp->num_observations() > 0 && mp->found() >= min_found) ++n;
+    if (mp && !outlier[i] && !mp->is_bad() && mp->is_established(id, min_found, 0)) ++n;
   }
   return n;
 }

@@ -75,7 +75,8 @@ struct Frame {
 
   Eigen::Vector3d camera_center() const { return T_cw.inverse().translation(); }
   int num_tracked() const;  // matched, non-outlier, non-bad
-  /// Matched, non-outlier map points (not temporary) found in at least `min_found` frames before.
+  /// Matched, non-outlier map points that are established (MapPoint::is_established) by the found count alone:
+  /// the motion-model cross-check was measured this way, before the age rule existed.
   int num_established(int min_found) const;
 };
 

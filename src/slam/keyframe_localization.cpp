@@ -8,25 +8,15 @@
 namespace varslam::slam {
 
 int refine_pose_on_matches(Frame& cur, const optim::KernelConfig& kernel) {
-  const FrameFeatures& F = *cur.features;
-  std::vector<Eigen::Vector3d> pts;
-  std::vector<optim::Observation> obs;
-  std::vector<int> idx;
-  for (std::size_t i = 0; i < cur.map_points.size(); ++i) {
-    const MapPointPtr& mp = cur.map_points[i];
-    if (!mp || mp->is_bad()) {
-      cur.map_points[i].reset();
-      continue;
-    }
-    pts.push_back(mp->position());
-    obs.push_back(keypoint_observation(F, i));
-    idx.push_back(static_cast<int>(i));
-  }
-  if (obs.size() < 3) return 0;
+  for (auto& mp : cur.map_points)
+    if (mp && mp->is_bad()) mp.reset();
+  const FramePoseProblem p = frame_pose_problem(cur);
+  const std::vector<int>& idx = p.keypoints;
+  if (idx.size() < 3) return 0;
   optim::PoseOptimConfig pc;
   pc.kernel = kernel;
   pc.solver = optim::PoseSolver::Dedicated;
-  const auto res = optim::optimize_pose(F.camera, cur.T_cw, pts, obs, pc);
+  const auto res = optim::optimize_pose(cur.features->camera, cur.T_cw, p.points, p.observations, pc);
   int inliers = 0;
   for (std::size_t k = 0; k < idx.size(); ++k) {
     cur.outlier[idx[k]] = false;

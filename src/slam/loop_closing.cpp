@@ -37,6 +37,13 @@ Eigen::Isometry3d world_change(const Eigen::Isometry3d& before, const Eigen::Iso
   return after.inverse() * before;
 }
 
+/// Keyframes tracking made while a correction was computed (not in `known`) follow the world change `W` of the
+/// newest keyframe that was corrected. Call under the map's update lock.
+void move_new_keyframes(const Map& map, const std::map<long, Eigen::Isometry3d>& known, const Eigen::Isometry3d& W) {
+  for (const auto& k : map.keyframes())
+    if (!k->is_bad() && !known.count(k->id())) k->set_pose(k->pose() * W.inverse());
+}
+
 }  // namespace
 
 LoopCloser::LoopCloser(const LoopConfig& cfg, const optim::KernelConfig& pose_kernel, Map& map,
@@ -236,21 +243,16 @@ void LoopCloser::optimize_pose_graph(const KeyFramePtr& kf,
   optim::optimize_pose_graph(pg, pc);
 
   std::unique_lock lock(map_.update_mutex());
-  std::map<long, Eigen::Isometry3d> before;
-  for (const auto& [id, v] : vertex) before[id] = initial.at(id);
   for (const auto& k : kfs)
     if (!k->is_bad() && vertex.count(k->id())) k->set_pose(pg.T_cw[vertex.at(k->id())]);
-  propagate(before, kf, initial.at(kf->id()));
+  propagate(initial, kf);
   map_.note_correction();
   rec.pose_graph_ms = ms_since(t0);
 }
 
-void LoopCloser::propagate(const std::map<long, Eigen::Isometry3d>& before, const KeyFramePtr& anchor,
-                           const Eigen::Isometry3d& anchor_before) {
-  const Eigen::Isometry3d W_anchor = world_change(anchor_before, anchor->pose());
-  // Keyframes tracking made meanwhile follow the anchor (the newest keyframe optimised).
-  for (const auto& k : map_.keyframes())
-    if (!k->is_bad() && !before.count(k->id())) k->set_pose(k->pose() * W_anchor.inverse());
+void LoopCloser::propagate(const std::map<long, Eigen::Isometry3d>& before, const KeyFramePtr& anchor) {
+  const Eigen::Isometry3d W_anchor = world_change(before.at(anchor->id()), anchor->pose());
+  move_new_keyframes(map_, before, W_anchor);
   // Points follow their reference keyframe (or any observer that was optimised); new points follow the anchor.
   for (const auto& mp : map_.map_points()) {
     if (mp->is_bad()) continue;
@@ -302,8 +304,7 @@ void LoopCloser::global_bundle_adjustment(const KeyFramePtr& kf, LoopRecord& rec
   std::set<long> optimised_points;
   for (const auto& mp : ba.points) optimised_points.insert(mp->id());
   // What tracking added while the solver ran follows the newest optimised keyframe.
-  for (const auto& k : map_.keyframes())
-    if (!k->is_bad() && !before.count(k->id())) k->set_pose(k->pose() * W_anchor.inverse());
+  move_new_keyframes(map_, before, W_anchor);
   for (const auto& mp : map_.map_points())
     if (!mp->is_bad() && !optimised_points.count(mp->id())) mp->set_position(W_anchor * mp->position());
   for (const auto& mp : ba.points)

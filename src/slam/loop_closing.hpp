@@ -56,9 +56,8 @@ class LoopCloser {
                            const std::map<long, Eigen::Isometry3d>& uncorrected, LoopRecord& rec);
   void global_bundle_adjustment(const KeyFramePtr& kf, LoopRecord& rec);
   /// Moves keyframes and points from `before` to the keyframes' current poses; keyframes and points created
-  /// meanwhile (not in `before`) follow `anchor`. Call under the map's update lock.
-  void propagate(const std::map<long, Eigen::Isometry3d>& before, const KeyFramePtr& anchor,
-                 const Eigen::Isometry3d& anchor_before);
+  /// meanwhile (not in `before`) follow `anchor` (which must be in `before`). Call under the map's update lock.
+  void propagate(const std::map<long, Eigen::Isometry3d>& before, const KeyFramePtr& anchor);
 
   LoopConfig cfg_;
   optim::KernelConfig pose_kernel_;

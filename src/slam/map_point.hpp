@@ -63,6 +63,11 @@ class MapPoint {
   void increase_found(int n = 1) { found_.fetch_add(n); }
   int found() const { return found_.load(); }
   double found_ratio() const { return static_cast<double>(found_.load()) / std::max(1, visible_.load()); }
+  /// A point tracking can lean on in frame `frame_id`: a real map point (not a temporary depth point), found as
+  /// an inlier in at least `min_found` frames and created at least `min_age` frames before.
+  bool is_established(long frame_id, int min_found, int min_age) const {
+    return num_observations() > 0 && found() >= min_found && frame_id - first_frame_id_ >= min_age;
+  }
 
   // Per-frame scratch used by tracking only (tracking thread).
   long track_reference_frame = -1;  // last frame id it was added to the local map for

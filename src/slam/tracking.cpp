@@ -158,8 +158,9 @@ void Tracker::refresh_last_frame() {
   // The reference keyframe may have moved (Local BA): re-anchor the last pose to it. A keyframe frame keeps
   // its own pose unless a loop correction moved the map (re-anchoring it after every Local BA measured
   // worse on the kitchen, 5.66 against 4.63 cm).
-  const bool map_corrected = map_.corrections() != seen_corrections_;
-  seen_corrections_ = map_.corrections();
+  const long corrections = map_.corrections();
+  const bool map_corrected = corrections != seen_corrections_;
+  seen_corrections_ = corrections;
   if (last_.reference_kf && (!last_is_keyframe_ || map_corrected))
     last_.T_cw = last_T_c_ref_ * last_.reference_kf->pose();
   if (last_is_keyframe_ || state_ != TrackState::Ok) return;
@@ -186,18 +187,9 @@ void Tracker::refresh_last_frame() {
 
 int Tracker::optimize_and_discard(Frame& cur, FrameTimings& t) {
   const auto t0 = Clock::now();
-  std::vector<Eigen::Vector3d> pts;
-  std::vector<optim::Observation> obs;
-  std::vector<int> idx;
-  const FrameFeatures& F = *cur.features;
-  for (std::size_t i = 0; i < cur.map_points.size(); ++i) {
-    const MapPointPtr& mp = cur.map_points[i];
-    if (!mp) continue;
-    pts.push_back(mp->position());
-    obs.push_back(keypoint_observation(F, i));
-    idx.push_back(static_cast<int>(i));
-  }
-  if (obs.size() < 3) return 0;
+  const FramePoseProblem p = frame_pose_problem(cur);
+  const std::vector<int>& idx = p.keypoints;
+  if (idx.size() < 3) return 0;
   // Trust the established points first: when enough matches go to points already tracked as inliers in several
   // frames, the first round solves on those alone and the others (temporary depth points, young map points) join
   // only where they agree with that pose. A mover entering the view brings many young points that agree with
@@ -205,9 +197,8 @@ int Tracker::optimize_and_discard(Frame& cur, FrameTimings& t) {
   std::vector<bool> young(idx.size(), false);
   int established = 0;
   for (std::size_t k = 0; k < idx.size(); ++k) {
-    const MapPointPtr& mp = cur.map_points[idx[k]];
-    young[k] = mp->num_observations() == 0 || mp->found() < cfg_.tracking.established_found ||
-               cur.id - mp->first_frame_id() < cfg_.tracking.established_age;
+    young[k] = !cur.map_points[idx[k]]->is_established(cur.id, cfg_.tracking.established_found,
+                                                        cfg_.tracking.established_age);
     established += !young[k];
   }
   const bool trust_established = cfg_.tracking.established_found > 0 && established >= kMinEstablished;
@@ -216,7 +207,8 @@ int Tracker::optimize_and_discard(Frame& cur, FrameTimings& t) {
   // The dedicated 6-DoF solver gives the same pose as Ceres (tested against it) at 1.5-2x less cost.
   pc.solver = optim::PoseSolver::Dedicated;
   pc.observer = cfg_.tracking.pose_observer;
-  const auto res = optim::optimize_pose(camera_, cur.T_cw, pts, obs, pc, trust_established ? &young : nullptr);
+  const auto res =
+      optim::optimize_pose(camera_, cur.T_cw, p.points, p.observations, pc, trust_established ? &young : nullptr);
   cur.has_pose = true;
   int inliers = 0;
   for (std::size_t k = 0; k < idx.size(); ++k) {
