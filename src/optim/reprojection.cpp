@@ -82,14 +82,16 @@ int whitened_residual(const PinholeCamera& cam, const Observation& obs, const Ei
   e[0] = s * (obs.uv.x() - u);
   e[1] = s * (obs.uv.y() - v);
   const int dof = obs.dof();
-  if (dof == 3) e[2] = s * (obs.u_right - (u - cam.bf * iz));
+  const double w = obs.disparity_weight;
+  if (dof == 3) e[2] = w > 0.0 ? s * w * ((obs.uv.x() - obs.u_right) - cam.bf * iz) : s * (obs.u_right - (u - cam.bf * iz));
   if (de_dpc) {
     const double iz2 = iz * iz;
     Eigen::Matrix3d& J = *de_dpc;
     J.row(0) << -s * cam.fx * iz, 0.0, s * cam.fx * p_c.x() * iz2;
     J.row(1) << 0.0, -s * cam.fy * iz, s * cam.fy * p_c.y() * iz2;
-    if (dof == 3) J.row(2) << J(0, 0), 0.0, J(0, 2) - s * cam.bf * iz2;
-    else J.row(2).setZero();
+    if (dof != 3) J.row(2).setZero();
+    else if (w > 0.0) J.row(2) << 0.0, 0.0, s * w * cam.bf * iz2;
+    else J.row(2) << J(0, 0), 0.0, J(0, 2) - s * cam.bf * iz2;
   }
   return dof;
 }

@@ -15,6 +15,9 @@ struct Observation {
   Eigen::Vector2d uv = Eigen::Vector2d::Zero();  // undistorted pixel
   double u_right = -1.0;                         // virtual right coordinate u - bf/depth; < 0 = monocular
   double inv_sigma2 = 1.0;                       // information scale of the keypoint's pyramid level
+  // Depth term: 0 = ORB-SLAM3's residual on the virtual right coordinate u_r (one pixel of noise, as a stereo
+  // match); > 0 = residual on the disparity bf/z alone, weighted by this ratio of keypoint to disparity sigma.
+  double disparity_weight = 0.0;
   bool stereo() const { return u_right >= 0.0; }
   int dof() const { return stereo() ? 3 : 2; }
 };

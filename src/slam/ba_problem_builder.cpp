@@ -7,6 +7,7 @@ optim::Observation keypoint_observation(const FrameFeatures& f, std::size_t i) {
   o.uv = {f.keypoints[i].pt.x, f.keypoints[i].pt.y};
   o.u_right = f.u_right[i];
   o.inv_sigma2 = f.scale->inv_level_sigma2[f.keypoints[i].octave];
+  o.disparity_weight = f.disparity_weight;
   return o;
 }
 

@@ -94,6 +94,10 @@ SlamConfig slam_config_from(const Settings& s) {
   c.tracking.min_inliers_local_map = setting_or<int>(s, "tracking.min_inliers", c.tracking.min_inliers_local_map);
   c.tracking.depth_edge_ratio = setting_or<double>(s, "depth.edge_ratio", c.tracking.depth_edge_ratio);
   c.tracking.depth_rig = read_depth_rig(s);
+  c.tracking.disparity_weight = setting_or<double>(s, "depth.disparity_weight", c.tracking.disparity_weight);
+  if (!(c.tracking.disparity_weight >= 0.0))
+    throw ConfigError(fmt::format("{}: depth.disparity_weight must be >= 0 (0: ORB-SLAM3's stereo-like depth residual)",
+                                  s.source.string()));
   c.tracking.vo_points = setting_or<int>(s, "tracking.vo_points", c.tracking.vo_points);
   c.tracking.close_keyframe_gap = setting_or<int>(s, "tracking.close_keyframe_gap", c.tracking.close_keyframe_gap);
   c.tracking.lost_frames_before_reinit =

@@ -30,6 +30,7 @@ struct FrameFeatures {
   std::shared_ptr<const ScaleInfo> scale;
   PinholeCamera camera;
   double close_depth = 3.0;  // metres: points closer than this are "close" (reliable depth)
+  double disparity_weight = 0.0;  // the depth sensor's noise model for optimisation (optim::Observation)
   int depth_edge_rejected = 0;  // keypoints whose depth was dropped by the depth-edge test
 
   static constexpr int kGridCols = 64, kGridRows = 48;

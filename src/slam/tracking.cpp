@@ -64,6 +64,7 @@ Frame Tracker::build_frame(const RgbdFrame& input, FrameTimings& t) {
   }
   auto features = make_frame_features(std::move(kps), desc, input.depth, camera_, close_depth_, scale_,
                                       cfg_.tracking.depth_edge_ratio);
+  features->disparity_weight = cfg_.tracking.disparity_weight;
   return Frame(next_frame_id_++, input.timestamp, std::move(features));
 }
 

@@ -13,8 +13,9 @@ Eigen::Isometry3d test_pose() {
   return T;
 }
 
-Observation test_obs(bool stereo) {
+Observation test_obs(bool stereo, double disparity_weight = 0.0) {
   Observation o;
+  o.disparity_weight = disparity_weight;
   o.uv << 300.0, 200.0;
   o.u_right = stereo ? 285.0 : -1.0;
   o.inv_sigma2 = 1.0 / (1.2 * 1.2);
@@ -23,9 +24,9 @@ Observation test_obs(bool stereo) {
 
 // Tangent Jacobian by central differences through the manifold's Plus (the update the solver applies).
 template <int Dof>
-void check_ba_jacobians(bool stereo) {
+void check_ba_jacobians(bool stereo, double disparity_weight = 0.0) {
   const PinholeCamera cam;
-  const ReprojectionCost<Dof> cost(cam, test_obs(stereo));
+  const ReprojectionCost<Dof> cost(cam, test_obs(stereo, disparity_weight));
   double x[kPoseParams];
   pose_to_params(test_pose(), x);
   double p[3] = {0.3, -0.4, 4.0};
@@ -71,6 +72,7 @@ void check_ba_jacobians(bool stereo) {
 
 TEST(Reprojection, MonoJacobiansMatchNumeric) { check_ba_jacobians<2>(false); }
 TEST(Reprojection, StereoJacobiansMatchNumeric) { check_ba_jacobians<3>(true); }
+TEST(Reprojection, DisparityJacobiansMatchNumeric) { check_ba_jacobians<3>(true, 4.0); }
 
 TEST(Reprojection, PoseOnlyCostMatchesBaCost) {
   const PinholeCamera cam;
@@ -106,6 +108,27 @@ TEST(Reprojection, ResidualIsWhitenedMeasuredMinusProjected) {
   EXPECT_NEAR(e[2], 2.0, 1e-12);
   o.u_right = -1;
   EXPECT_EQ(whitened_residual(cam, o, p_c, e, nullptr), 2);
+}
+
+// With a disparity weight the depth term measures disparity alone: a keypoint offset in u leaves it untouched,
+// a depth error shows up weighted.
+TEST(Reprojection, DisparityResidualIgnoresKeypointOffsetAndWeightsDepth) {
+  PinholeCamera cam;
+  const Eigen::Vector3d p_c(0.2, -0.1, 2.0);
+  const Eigen::Vector2d uv = cam.project(p_c);
+  Observation o;
+  o.uv = uv + Eigen::Vector2d(2.0, 0.0);
+  const double measured_disparity = cam.bf / p_c.z() + 0.5;
+  o.u_right = o.uv.x() - measured_disparity;
+  o.inv_sigma2 = 0.25;
+  o.disparity_weight = 8.0;
+  double e[3];
+  ASSERT_EQ(whitened_residual(cam, o, p_c, e, nullptr), 3);
+  EXPECT_NEAR(e[0], 1.0, 1e-12);
+  EXPECT_NEAR(e[2], 0.5 * 8.0 * 0.5, 1e-9);
+  o.disparity_weight = 0.0;  // ORB-SLAM3's u_r residual mixes the keypoint offset in: (2 - 0.5) / 2
+  ASSERT_EQ(whitened_residual(cam, o, p_c, e, nullptr), 3);
+  EXPECT_NEAR(e[2], 0.75, 1e-9);
 }
 
 TEST(PoseManifold, PlusMatchesLeftUpdateAndMinusInvertsIt) {

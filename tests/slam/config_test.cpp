@@ -54,6 +54,21 @@ TEST(SlamConfig, UnknownKernelNamesFileAndKey) {
   }
 }
 
+TEST(SlamConfig, DisparityWeightIsReadAndChecked) {
+  Settings s = load_settings(write_settings("cfg_dw.yaml", ""));
+  EXPECT_DOUBLE_EQ(slam_config_from(s).tracking.disparity_weight, 10.0);
+  s.root["depth"]["disparity_weight"] = 0.0;  // ORB-SLAM3's residual
+  EXPECT_DOUBLE_EQ(slam_config_from(s).tracking.disparity_weight, 0.0);
+  s.root["depth"]["disparity_weight"] = -2.0;
+  try {
+    slam_config_from(s);
+    FAIL() << "expected ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("depth.disparity_weight"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("cfg_dw.yaml"), std::string::npos) << e.what();
+  }
+}
+
 TEST(SlamConfig, RejectsNonPositiveTau) {
   EXPECT_THROW(slam_config_from(load_settings(write_settings("cfg_tau.yaml", "mapping: {tau: -1}\n"))), ConfigError);
 }
