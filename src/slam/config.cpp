@@ -94,6 +94,11 @@ SlamConfig slam_config_from(const Settings& s) {
   c.tracking.min_inliers_local_map = setting_or<int>(s, "tracking.min_inliers", c.tracking.min_inliers_local_map);
   c.tracking.depth_edge_ratio = setting_or<double>(s, "depth.edge_ratio", c.tracking.depth_edge_ratio);
   c.tracking.depth_rig = read_depth_rig(s);
+  const std::string registration = setting_or<std::string>(s, "depth.registration", "auto");
+  if (registration != "auto" && registration != "off")
+    throw ConfigError(fmt::format("{}: key depth.registration must be 'auto' or 'off', got '{}'", s.source.string(),
+                                  registration));
+  c.tracking.estimate_registration = registration == "auto";
   c.tracking.disparity_weight = setting_or<double>(s, "depth.disparity_weight", c.tracking.disparity_weight);
   if (!(c.tracking.disparity_weight >= 0.0))
     throw ConfigError(fmt::format("{}: depth.disparity_weight must be >= 0 (0: ORB-SLAM3's stereo-like depth residual)",

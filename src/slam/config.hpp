@@ -41,6 +41,9 @@ struct TrackingConfig {
   // Set when depth comes from a separate, unregistered camera (raw Kinect v1, 7-Scenes): the depth image is
   // warped into the colour camera before keypoint depths are read (keys depth.camera_fx/fy/cx/cy/tx/ty/tz).
   std::optional<DepthCameraRig> depth_rig;
+  // Without depth_rig: check on a few frames whether depth is registered to colour, and register it when it
+  // clearly is not (runner.cpp; depth.registration: auto | off).
+  bool estimate_registration = true;
   optim::PoseProblemObserver pose_observer;  // debug/benchmark hook: sees every pose problem (empty: none)
 };
 

@@ -13,6 +13,8 @@
 #include "core/error.hpp"
 #include "eval/ate.hpp"
 #include "eval/rpe.hpp"
+#include "io/colour_registration.hpp"
+#include "io/depth_image.hpp"
 #include "io/trajectory_io.hpp"
 #include "semantic/dynamic_keypoint_masker.hpp"
 #include "semantic/filter_stages_image.hpp"
@@ -23,6 +25,44 @@ namespace varslam::slam {
 
 namespace {
 using Clock = std::chrono::steady_clock;
+
+// Raw depth from a separate depth camera (7-Scenes, raw Kinect v1) misfits the colour edges; the settings'
+// intrinsics then describe the depth camera. Estimated on up to 10 frames of the first 10 s; when a mapping
+// clearly beats identity, depth is warped into the colour camera it implies. Registered data (TUM, Bonn,
+// synthetic) comes out as identity and runs unchanged.
+nlohmann::json register_depth_if_needed(const Dataset& ds, std::size_t first, std::size_t count, Settings& settings,
+                                        SlamConfig& cfg) {
+  if (cfg.tracking.depth_rig) return {{"mode", "settings"}};
+  if (!cfg.tracking.estimate_registration) return {{"mode", "off"}};
+  const auto t0 = Clock::now();
+  const std::size_t span = std::min<std::size_t>(count, 300), n = std::min<std::size_t>(span, 10);
+  std::vector<cv::Mat> grays, depths;
+  for (std::size_t k = 0; k < n; ++k) {
+    try {
+      RgbdFrame f = ds.load(first + k * span / n);
+      grays.push_back(f.gray);
+      depths.push_back(f.depth);
+    } catch (const InputError&) {
+      // an unreadable frame is reported by the run itself; estimate on the others
+    }
+  }
+  const ColourRegistration reg = estimate_colour_registration(grays, depths, settings.camera);
+  nlohmann::json j = {{"mode", "auto"}, {"found", reg.found}, {"scale", reg.scale}, {"du", reg.du}, {"dv", reg.dv},
+                      {"score", reg.score}, {"identity_score", reg.identity_score}, {"frames", reg.frames},
+                      {"ms", std::chrono::duration<double, std::milli>(Clock::now() - t0).count()}};
+  if (reg.found) {
+    DepthCameraRig rig;
+    rig.depth = settings.camera;
+    settings.camera = reg.colour_camera(rig.depth);
+    cfg.tracking.depth_rig = rig;
+    j["colour_camera"] = {{"fx", settings.camera.fx}, {"fy", settings.camera.fy}, {"cx", settings.camera.cx},
+                          {"cy", settings.camera.cy}};
+    spdlog::info("depth is not registered to colour (edge fit {:.2f} against {:.2f} as given): colour camera fx {:.1f} "
+                 "cx {:.1f} cy {:.1f}, depth warped into it (depth.registration: off to keep the images as they are)",
+                 reg.score, reg.identity_score, settings.camera.fx, settings.camera.cx, settings.camera.cy);
+  }
+  return j;
+}
 
 const char* state_name(TrackState s) {
   switch (s) {
@@ -64,12 +104,15 @@ void write_map_ply(const Map& map, const std::filesystem::path& file) {
   for (const auto& p : pts) out << fmt::format("{:.5f} {:.5f} {:.5f}\n", p.x(), p.y(), p.z());
 }
 
-RunSummary run_slam(const Dataset& dataset, const Settings& settings, const SlamConfig& cfg,
+RunSummary run_slam(const Dataset& dataset, const Settings& given_settings, const SlamConfig& given_cfg,
                     const RunOptions& options, const std::filesystem::path& out_dir) {
   std::filesystem::create_directories(out_dir);
   const std::size_t first = std::min(options.first, dataset.size());
   const std::size_t count = std::min(options.max_frames, dataset.size() - first);
   if (count == 0) throw InputError(fmt::format("{}: no frames to process", dataset.root().string()));
+  Settings settings = given_settings;
+  SlamConfig cfg = given_cfg;
+  const nlohmann::json registration = register_depth_if_needed(dataset, first, count, settings, cfg);
 
   System system(cfg, settings.camera, settings.close_depth_m(), options.mode);
 
@@ -205,6 +248,7 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const Slam
   m["culled_keyframes"] = ms.culled_keyframes;
   m["wall_seconds"] = wall;
   m["fps"] = sum.fps;
+  m["depth_registration"] = registration;
   m["kernels"] = {{"tracking", kernel_name(cfg.tracking.kernel.type)}, {"mapping", kernel_name(cfg.mapping.kernel.type)}};
   m["timings"] = {{"load", timing_json(load)},       {"extract", timing_json(extract)},
                   {"filter", timing_json(filt)},     {"match", timing_json(match)},

@@ -69,6 +69,20 @@ TEST(SlamConfig, DisparityWeightIsReadAndChecked) {
   }
 }
 
+TEST(SlamConfig, DepthRegistrationIsAutoOrOff) {
+  Settings s = load_settings(write_settings("cfg_reg.yaml", ""));
+  EXPECT_TRUE(slam_config_from(s).tracking.estimate_registration);
+  s.root["depth"]["registration"] = "off";
+  EXPECT_FALSE(slam_config_from(s).tracking.estimate_registration);
+  s.root["depth"]["registration"] = "yes";
+  try {
+    slam_config_from(s);
+    FAIL() << "expected ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("depth.registration"), std::string::npos) << e.what();
+  }
+}
+
 TEST(SlamConfig, RejectsNonPositiveTau) {
   EXPECT_THROW(slam_config_from(load_settings(write_settings("cfg_tau.yaml", "mapping: {tau: -1}\n"))), ConfigError);
 }
