@@ -49,8 +49,7 @@ void add_demo_command(CLI::App& app) {
     // kernel handles everything else that moves. Command-line overrides come last and win.
     std::vector<std::string> overrides = {"semantic.detector=boxes",
                                           "semantic.boxes_file=" + (data / "boxes.txt").string(),
-                                          "tracking.kernel=barron-fixed", "tracking.barron_alpha=1",
-                                          "mapping.kernel=barron-adaptive"};
+                                          "tracking.kernel=barron-fixed", "mapping.kernel=barron-adaptive"};
     overrides.insert(overrides.end(), o->overrides.begin(), o->overrides.end());
     apply_overrides(settings, overrides);
     const slam::SlamConfig cfg = slam::slam_config_from(settings);

@@ -32,7 +32,7 @@ std::vector<std::string> configuration_overrides(const BenchConfiguration& confi
                                                  const fs::path& boxes_file) {
   std::vector<std::string> o;
   if (config.robust) {
-    o = {"tracking.kernel=barron-fixed", "tracking.barron_alpha=1", "mapping.kernel=barron-adaptive"};
+    o = {"tracking.kernel=barron-fixed", "mapping.kernel=barron-adaptive"};  // tracking alpha: the default
   } else {
     o = {"tracking.kernel=huber", "mapping.kernel=huber"};
   }
