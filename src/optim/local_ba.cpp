@@ -291,4 +291,23 @@ BaResult solve_local_ba(const PinholeCamera& cam, BaProblem& problem, const BaCo
   return result;
 }
 
+std::vector<int> keep_diverged_keyframes(BaProblem& problem, const std::vector<Eigen::Isometry3d>& before,
+                                         std::vector<bool>& outlier_observation) {
+  std::vector<int> total(problem.keyframes.size()), bad(problem.keyframes.size());
+  for (std::size_t o = 0; o < problem.observations.size(); ++o) {
+    ++total[static_cast<std::size_t>(problem.observations[o].keyframe)];
+    if (outlier_observation[o]) ++bad[static_cast<std::size_t>(problem.observations[o].keyframe)];
+  }
+  std::vector<int> reset;
+  for (std::size_t i = 0; i < problem.keyframes.size(); ++i) {
+    if (problem.keyframes[i].fixed || 2 * bad[i] <= total[i]) continue;
+    problem.keyframes[i].T_cw = before[i];
+    reset.push_back(static_cast<int>(i));
+  }
+  for (std::size_t o = 0; o < problem.observations.size(); ++o)
+    if (std::find(reset.begin(), reset.end(), problem.observations[o].keyframe) != reset.end())
+      outlier_observation[o] = false;
+  return reset;
+}
+
 }  // namespace varslam::optim

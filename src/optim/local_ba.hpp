@@ -81,5 +81,11 @@ struct BaResult {
 /// Throws std::invalid_argument on an observation indexing a missing keyframe or point.
 BaResult solve_local_ba(const PinholeCamera& cam, BaProblem& problem, const BaConfig& cfg);
 
+/// A free keyframe that the solve left with more than half of its observations flagged as outliers has
+/// diverged (seen: 220 of 284, moved 1.46 m, in a walking scene): its pose goes back to `before` (one pose per
+/// problem keyframe) and its observations are unflagged. Returns the indices of the keyframes reset.
+std::vector<int> keep_diverged_keyframes(BaProblem& problem, const std::vector<Eigen::Isometry3d>& before,
+                                         std::vector<bool>& outlier_observation);
+
 
 }  // namespace varslam::optim

@@ -35,29 +35,6 @@ bool triangulate_dlt(const Eigen::Isometry3d& T1, const Eigen::Isometry3d& T2, c
   return out.allFinite();
 }
 
-// A keyframe that Local BA left with most of its observations as outliers has diverged (seen: 220 of 284,
-// moved 1.46 m, in the demo's walking scene): it keeps its tracked pose and its observations.
-void keep_diverged_keyframes(BaProblemBuilder& ba, std::vector<bool>& outlier_observation) {
-  optim::BaProblem& problem = ba.problem;
-  std::vector<int> total(problem.keyframes.size()), bad(problem.keyframes.size());
-  for (std::size_t o = 0; o < problem.observations.size(); ++o) {
-    ++total[problem.observations[o].keyframe];
-    if (outlier_observation[o]) ++bad[problem.observations[o].keyframe];
-  }
-  std::vector<bool> diverged(problem.keyframes.size(), false);
-  for (std::size_t i = 0; i < problem.keyframes.size(); ++i) {
-    if (problem.keyframes[i].fixed || 2 * bad[i] <= total[i]) continue;
-    spdlog::debug("Local BA: keyframe {} left with {} of {} observations as outliers, moved {:.3f} m: kept as tracked",
-                  ba.keyframes[i]->id(), bad[i], total[i],
-                  (problem.keyframes[i].T_cw.inverse().translation() -
-                   ba.keyframes[i]->pose().inverse().translation()).norm());
-    problem.keyframes[i].T_cw = ba.keyframes[i]->pose();
-    diverged[i] = true;
-  }
-  for (std::size_t o = 0; o < problem.observations.size(); ++o)
-    if (diverged[problem.observations[o].keyframe]) outlier_observation[o] = false;
-}
-
 }  // namespace
 
 LocalMapper::LocalMapper(const MappingConfig& cfg, Map& map, std::shared_ptr<const ScaleInfo> scale, double close_depth)
@@ -323,7 +300,11 @@ void LocalMapper::local_ba(const KeyFramePtr& kf) {
   bc.observer = cfg_.ba_observer;
   const PinholeCamera& cam = kf->features().camera;
   optim::BaResult res = optim::solve_local_ba(cam, problem, bc);
-  keep_diverged_keyframes(ba, res.outlier_observation);
+  std::vector<Eigen::Isometry3d> before;
+  for (const auto& k : ba.keyframes) before.push_back(k->pose());
+  for (const int i : optim::keep_diverged_keyframes(problem, before, res.outlier_observation))
+    spdlog::debug("Local BA for keyframe {}: keyframe {} diverged (most observations outliers), kept as tracked",
+                  kf->id(), ba.keyframes[static_cast<std::size_t>(i)]->id());
 
   int outliers = 0;
   {

@@ -245,3 +245,36 @@ TEST(LocalBa, RejectsObservationOfMissingPoint) {
 
 }  // namespace
 }  // namespace varslam::optim
+
+namespace varslam::optim {
+namespace {
+
+// Free keyframe 0 lost 6 of 10 observations to the gate: reset and unflagged. Free keyframe 1 lost 1 of 10:
+// kept as solved. Fixed keyframe 2 is never touched.
+TEST(KeepDivergedKeyframes, ResetsOnlyFreeKeyframesLeftWithMostlyOutliers) {
+  BaProblem problem;
+  std::vector<Eigen::Isometry3d> before;
+  for (int k = 0; k < 3; ++k) {
+    Eigen::Isometry3d solved = Eigen::Isometry3d::Identity();
+    solved.translation() << 1.0 + k, 0.0, 0.0;
+    problem.keyframes.push_back({solved, k == 2});
+    before.push_back(Eigen::Isometry3d::Identity());
+  }
+  std::vector<bool> outlier;
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < 10; ++j) {
+      problem.observations.push_back({k, j, Observation{}});
+      outlier.push_back((k == 0 && j < 6) || (k == 1 && j < 1) || k == 2);
+    }
+  const std::vector<int> reset = keep_diverged_keyframes(problem, before, outlier);
+  ASSERT_EQ(reset, std::vector<int>{0});
+  EXPECT_TRUE(problem.keyframes[0].T_cw.isApprox(before[0]));
+  EXPECT_DOUBLE_EQ(problem.keyframes[1].T_cw.translation().x(), 2.0);
+  EXPECT_DOUBLE_EQ(problem.keyframes[2].T_cw.translation().x(), 3.0);
+  for (int j = 0; j < 10; ++j) EXPECT_FALSE(outlier[static_cast<std::size_t>(j)]) << j;
+  EXPECT_TRUE(outlier[10]);
+  EXPECT_TRUE(outlier[20]);
+}
+
+}  // namespace
+}  // namespace varslam::optim
