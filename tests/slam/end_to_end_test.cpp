@@ -2,6 +2,7 @@
 // is present). Bounds are loose enough for noise, tight enough that a broken tracker fails them.
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -29,6 +30,27 @@ fs::path test_dir(const std::string& name) {
   const fs::path d = fs::temp_directory_path() / ("varslam_e2e_" + name);
   fs::remove_all(d);
   return d;
+}
+
+// A synthetic sequence along one of the real camera paths in ../shared/trajectories, cached under `name`;
+// empty when ../shared is absent.
+fs::path path_sequence(const std::string& name, const std::string& path_name, const std::string& scenario,
+                       double seconds, std::uint64_t seed, double path_start) {
+  const fs::path path = fs::path(VARSLAM_SHARED_DIR) / "trajectories" / path_name;
+  if (!fs::exists(path)) return {};
+  synth::SynthConfig cfg;
+  cfg.scenario = scenario;
+  cfg.seconds = seconds;
+  cfg.seed = seed;
+  cfg.path_file = path;
+  cfg.path_start = path_start;
+  return cached_sequence(name, cfg);
+}
+
+void expect_tracked_with_ate_below(const RunSummary& s, double bound_m) {
+  EXPECT_EQ(s.tracked, s.frames);
+  ASSERT_TRUE(s.ate_rmse.has_value());
+  EXPECT_LT(*s.ate_rmse, bound_m) << "ATE RMSE " << *s.ate_rmse << " m";
 }
 
 const fs::path& static_sequence() {
@@ -77,19 +99,9 @@ TEST(EndToEnd, RealTimeModeTracksTheSameSequence) {
 // reference-keyframe cross-check (tracking.motion_inlier_ratio = 0) the run ended at 47 cm instead of 0.5 cm.
 // The richer generator-3 room tracks this window either way (0.4 cm); the test keeps the jerky path covered.
 TEST(EndToEnd, JerkyHandHeldPathIsTracked) {
-  const fs::path path = fs::path(VARSLAM_SHARED_DIR) / "trajectories" / "rgbd_bonn_crowd3";
-  if (!fs::exists(path)) GTEST_SKIP() << "camera paths not found at " << path << " (../shared is absent)";
-  synth::SynthConfig cfg;
-  cfg.scenario = "static";
-  cfg.seconds = 2.0;
-  cfg.seed = 2;
-  cfg.path_file = path;
-  cfg.path_start = 13.5;
-  const fs::path seq = cached_sequence("jerky_seq", cfg);
-  const RunSummary s = run_on(seq, test_dir("jerky"), RunMode::Deterministic);
-  EXPECT_EQ(s.tracked, s.frames);
-  ASSERT_TRUE(s.ate_rmse.has_value());
-  EXPECT_LT(*s.ate_rmse, 0.02) << "ATE RMSE " << *s.ate_rmse << " m";
+  const fs::path seq = path_sequence("jerky_seq", "rgbd_bonn_crowd3", "static", 2.0, 2, 13.5);
+  if (seq.empty()) GTEST_SKIP() << "camera paths not found under " << VARSLAM_SHARED_DIR << " (../shared is absent)";
+  expect_tracked_with_ate_below(run_on(seq, test_dir("jerky"), RunMode::Deterministic), 0.02);
 }
 
 // Three people walk in front of a background 4-5 m away (bonn_crowd3 path, seed 1); the boxes filter takes
@@ -98,15 +110,9 @@ TEST(EndToEnd, JerkyHandHeldPathIsTracked) {
 // virtual-stereo noise, depth.disparity_weight = 0) the pose jumped 21 cm in one frame: ATE 4.6 cm over this
 // second (8.3 cm over three). Weighting the disparity as a Kinect measures it keeps the pose (1.6 cm).
 TEST(EndToEnd, PeopleFilteredFromFarBackgroundKeepThePose) {
-  const fs::path path = fs::path(VARSLAM_SHARED_DIR) / "trajectories" / "rgbd_bonn_crowd3";
-  if (!fs::exists(path)) GTEST_SKIP() << "camera paths not found at " << path << " (../shared is absent)";
-  synth::SynthConfig cfg;
-  cfg.scenario = "walking";
-  cfg.seconds = 3.0;  // the movers are planned over the whole sequence; the first second is what is run
-  cfg.seed = 1;
-  cfg.path_file = path;
-  cfg.path_start = 12.8;
-  const fs::path seq = cached_sequence("far_background_walking_3s", cfg);
+  // 3 s: the movers are planned over the whole sequence; the first second is what is run.
+  const fs::path seq = path_sequence("far_background_walking_3s", "rgbd_bonn_crowd3", "walking", 3.0, 1, 12.8);
+  if (seq.empty()) GTEST_SKIP() << "camera paths not found under " << VARSLAM_SHARED_DIR << " (../shared is absent)";
   Settings settings = settings_for_dataset(seq, std::nullopt);
   settings.root["semantic"]["detector"] = "boxes";
   settings.root["semantic"]["boxes_file"] = "boxes.txt";
@@ -116,10 +122,7 @@ TEST(EndToEnd, PeopleFilteredFromFarBackgroundKeepThePose) {
   RunOptions ro;
   ro.progress = false;
   ro.max_frames = 30;
-  const RunSummary s = run_slam(*ds, settings, slam, ro, test_dir("far_background"));
-  EXPECT_EQ(s.tracked, s.frames);
-  ASSERT_TRUE(s.ate_rmse.has_value());
-  EXPECT_LT(*s.ate_rmse, 0.025) << "ATE RMSE " << *s.ate_rmse << " m";
+  expect_tracked_with_ate_below(run_slam(*ds, settings, slam, ro, test_dir("far_background")), 0.025);
 }
 
 // A 38 cm box flies past 2 m away at 0.95 m/s in front of a wall 5 m away (unknown_box, fr3_sitting_static
@@ -128,29 +131,18 @@ TEST(EndToEnd, PeopleFilteredFromFarBackgroundKeepThePose) {
 // followed the box from the first frame: 47 cm over this second, 96 cm over three. The redescending default
 // (alpha -2) lets the box's residuals go once they pass a few pixels: 0.3 cm.
 TEST(EndToEnd, BoxFlyingPastIsNotFollowed) {
-  const fs::path path = fs::path(VARSLAM_SHARED_DIR) / "trajectories" / "rgbd_dataset_freiburg3_sitting_static";
-  if (!fs::exists(path)) GTEST_SKIP() << "camera paths not found at " << path << " (../shared is absent)";
-  synth::SynthConfig cfg;
-  cfg.scenario = "unknown_box";
-  cfg.seconds = 3.0;  // the movers are planned over the whole sequence; the first second is what is run
-  cfg.seed = 2;
-  cfg.path_file = path;
-  cfg.path_start = 10.3;
-  const fs::path seq = cached_sequence("box_flying_past_3s", cfg);
-  const RunSummary s = run_on(seq, test_dir("box_flying_past"), RunMode::Deterministic, 30);
-  EXPECT_EQ(s.tracked, s.frames);
-  ASSERT_TRUE(s.ate_rmse.has_value());
-  EXPECT_LT(*s.ate_rmse, 0.02) << "ATE RMSE " << *s.ate_rmse << " m";
+  // 3 s: the movers are planned over the whole sequence; the first second is what is run.
+  const fs::path seq =
+      path_sequence("box_flying_past_3s", "rgbd_dataset_freiburg3_sitting_static", "unknown_box", 3.0, 2, 10.3);
+  if (seq.empty()) GTEST_SKIP() << "camera paths not found under " << VARSLAM_SHARED_DIR << " (../shared is absent)";
+  expect_tracked_with_ate_below(run_on(seq, test_dir("box_flying_past"), RunMode::Deterministic, 30), 0.02);
 }
 
 TEST(EndToEnd, RealKitchenExcerpt) {
   const fs::path data = fs::path(VARSLAM_SHARED_DIR) / "realdata" / "7scenes_redkitchen";
   if (!fs::exists(data)) GTEST_SKIP() << "real data not found at " << data << " (../shared is absent)";
-  const RunSummary s = run_on(data, test_dir("kitchen"), RunMode::Deterministic, 150);
-  EXPECT_EQ(s.tracked, s.frames);
-  ASSERT_TRUE(s.ate_rmse.has_value());
   // KinectFusion ground truth and unregistered depth: a few cm is the honest expectation on 150 frames.
-  EXPECT_LT(*s.ate_rmse, 0.04) << "ATE RMSE " << *s.ate_rmse << " m";
+  expect_tracked_with_ate_below(run_on(data, test_dir("kitchen"), RunMode::Deterministic, 150), 0.04);
 }
 
 }  // namespace
