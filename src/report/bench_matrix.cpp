@@ -17,7 +17,7 @@ const std::vector<BenchConfiguration>& known_configurations() {
   static const std::vector<BenchConfiguration> configs = {
       {"huber", "ORB-SLAM3 baseline: Huber kernels, no detector", false, false},
       {"semantic", "VAR-SLAM-S: Huber kernels + depth-aware person filter", true, false},
-      {"kernel", "VAR-SLAM-RK: Barron kernels (alpha=1 tracking, adaptive mapping), no detector", false, true},
+      {"kernel", "VAR-SLAM-RK: Barron kernels (fixed shape in tracking, adaptive in mapping), no detector", false, true},
       {"full", "VAR-SLAM: Barron kernels + person filter", true, true}};
   return configs;
 }

@@ -140,6 +140,9 @@ SlamConfig slam_config_from(const Settings& s) {
   l.min_inliers = setting_or<int>(s, "loop.min_inliers", l.min_inliers);
   l.keyframes_after_loop = setting_or<int>(s, "loop.keyframes_after_loop", l.keyframes_after_loop);
   l.pose_graph_min_weight = setting_or<int>(s, "loop.pose_graph_min_weight", l.pose_graph_min_weight);
+  l.max_own_pose_share = setting_or<double>(s, "loop.max_own_pose_share", l.max_own_pose_share);
+  if (l.max_own_pose_share < 0)
+    throw ConfigError(fmt::format("{}: loop.max_own_pose_share must be >= 0", s.source.string()));
   l.global_ba = setting_or<bool>(s, "loop.global_ba", l.global_ba);
   l.global_ba_iterations = setting_or<int>(s, "loop.global_ba_iterations", l.global_ba_iterations);
   l.final_global_ba = setting_or<bool>(s, "loop.final_global_ba", l.final_global_ba);

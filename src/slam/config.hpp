@@ -68,6 +68,9 @@ struct LoopConfig {
   int min_ransac_inliers = 25;  // 3-D/3-D RANSAC inliers against the candidate keyframe
   int min_inliers = 80;         // pose inliers after guided matching against the candidate's neighbourhood
   int keyframes_after_loop = 5; // keyframes skipped after a closure (the same loop is found again at once)
+  // A candidate is rejected when, matched from the keyframe's own pose, its neighbourhood gives at least this share
+  // of the inliers the loop pose gives (the map already agrees; the loop pose follows a mover). 0: no check.
+  double max_own_pose_share = 0.2;
   int pose_graph_min_weight = 100;  // covisibility weight for a pose-graph edge (besides the spanning tree)
   bool global_ba = true;
   int global_ba_iterations = 10;

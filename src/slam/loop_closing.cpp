@@ -128,6 +128,11 @@ bool LoopCloser::verify(const KeyFramePtr& kf, const PlaceCandidate& cand, Detec
   spdlog::debug("loop candidate {} for keyframe {}: score {}, ransac {}, guided inliers {}", cand.keyframe->id(),
                 kf->id(), cand.score, ransac_inliers, inliers);
   if (inliers < cfg_.min_inliers) return false;
+  if (loop_side_agrees_with_own_pose(kf, loop_points, inliers, f.T_cw)) {
+    spdlog::debug("loop candidate {} for keyframe {} rejected: its neighbourhood agrees with the keyframe's own pose, "
+                  "the loop pose follows a mover", cand.keyframe->id(), kf->id());
+    return false;
+  }
   out.loop_kf = cand.keyframe;
   out.score = cand.score;
   out.ransac_inliers = ransac_inliers;
@@ -136,6 +141,21 @@ bool LoopCloser::verify(const KeyFramePtr& kf, const PlaceCandidate& cand, Detec
   out.matches = f.map_points;
   out.loop_points = std::move(loop_points);
   return true;
+}
+
+bool LoopCloser::loop_side_agrees_with_own_pose(const KeyFramePtr& kf, const std::vector<MapPointPtr>& loop_points,
+                                                 int loop_inliers, const Eigen::Isometry3d& T_cw_loop) const {
+  // The no-loop hypothesis: the same neighbourhood matched from the keyframe's own pose. Drift worth a loop leaves
+  // little to match there; when much of the loop side agrees with the own pose, the map is consistent here and the
+  // loop pose follows something that moved between the two visits (a box held in front of the camera).
+  if (cfg_.max_own_pose_share <= 0) return false;
+  Frame g = frame_of(*kf);
+  match_local_map(g, loop_points, 1.0, /*count_visible=*/false);
+  const int own_inliers = refine_pose_on_matches(g, pose_kernel_);
+  const Eigen::Vector3d refined = g.T_cw.inverse().translation();
+  const bool stays_at_own = (kf->camera_center() - refined).norm() < (T_cw_loop.inverse().translation() - refined).norm();
+  spdlog::debug("keyframe {}: {} inliers at the loop pose, {} at its own pose", kf->id(), loop_inliers, own_inliers);
+  return stays_at_own && own_inliers >= cfg_.max_own_pose_share * loop_inliers;
 }
 
 void LoopCloser::correct(const KeyFramePtr& kf, Detection& det, LoopRecord& rec) {

@@ -51,6 +51,10 @@ class LoopCloser {
   };
   std::optional<Detection> detect(const KeyFramePtr& kf);
   bool verify(const KeyFramePtr& kf, const PlaceCandidate& cand, Detection& out) const;
+  /// True when the loop side, matched from the keyframe's own pose, explains a large share (LoopConfig::
+  /// max_own_pose_share) of what the loop pose explains and keeps the pose there: no drift, a mover.
+  bool loop_side_agrees_with_own_pose(const KeyFramePtr& kf, const std::vector<MapPointPtr>& loop_points,
+                                      int loop_inliers, const Eigen::Isometry3d& T_cw_loop) const;
   void correct(const KeyFramePtr& kf, Detection& det, LoopRecord& rec);
   void optimize_pose_graph(const KeyFramePtr& kf, const std::vector<std::pair<KeyFramePtr, KeyFramePtr>>& new_links,
                            const std::map<long, Eigen::Isometry3d>& uncorrected, LoopRecord& rec);

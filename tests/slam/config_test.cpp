@@ -70,6 +70,21 @@ TEST(SlamConfig, DisparityWeightIsReadAndChecked) {
   }
 }
 
+TEST(SlamConfig, LoopOwnPoseShareIsReadAndChecked) {
+  Settings s = load_settings(write_settings("cfg_own.yaml", ""));
+  EXPECT_DOUBLE_EQ(slam_config_from(s).loop.max_own_pose_share, 0.2);
+  s.root["loop"]["max_own_pose_share"] = 0.0;  // no check
+  EXPECT_DOUBLE_EQ(slam_config_from(s).loop.max_own_pose_share, 0.0);
+  s.root["loop"]["max_own_pose_share"] = -0.5;
+  try {
+    slam_config_from(s);
+    FAIL() << "expected ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("loop.max_own_pose_share"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("cfg_own.yaml"), std::string::npos) << e.what();
+  }
+}
+
 TEST(SlamConfig, DepthRegistrationIsAutoOrOff) {
   Settings s = load_settings(write_settings("cfg_reg.yaml", ""));
   EXPECT_TRUE(slam_config_from(s).tracking.estimate_registration);

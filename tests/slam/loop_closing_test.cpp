@@ -27,6 +27,9 @@ enum class LastView {
   SamePlace,     // the start's points, as they are
   OtherPlace,    // the same geometry with descriptors never seen before
   Scrambled,     // the start's descriptors at positions dealt out at random (no consistent geometry)
+  // No drift at all, and a textured box seen in front of the start is back in front of the returning keyframe,
+  // moved 0.3 m to the side: matched to itself, the box proposes a loop correction that is no drift.
+  MoverMatchedToItself,
 };
 
 /// The map a tracker with drift would have built, with the true poses next to it. World points sit on a cylinder
@@ -43,6 +46,7 @@ class LoopMap {
 
   explicit LoopMap(LastView last_view = LastView::SamePlace) : last_view_(last_view) {
     make_room(1200);
+    if (last_view_ == LastView::MoverMatchedToItself) make_box(400);
     for (int k = 0; k < kKeyframes; ++k) add_keyframe(k);
     for (const auto& mp : map.map_points()) {
       mp->compute_descriptor();
@@ -81,12 +85,30 @@ class LoopMap {
   }
   std::shared_ptr<const ScaleInfo> scale() const { return scale_; }
   const Eigen::Vector3d& true_point(int p) const { return world_.points[p]; }
+  static constexpr double kBoxShift = 0.3;  // how far the box moved between the start and the return (m)
 
  private:
   LastView last_view_;
   std::mt19937 rng_{5};
   std::shared_ptr<const ScaleInfo> scale_ = synthetic::scale_info();
   synthetic::World world_;
+  synthetic::World box_at_start_, box_at_return_;  // the same box (same descriptors) before and after it moved
+  std::vector<MapPointPtr> box_points_;            // the start's map points on the box
+
+  Eigen::Isometry3d drift_of(int k) const {
+    return last_view_ == LastView::MoverMatchedToItself ? Eigen::Isometry3d::Identity() : drift(drift_fraction(k));
+  }
+
+  void make_box(int n) {
+    std::uniform_real_distribution<double> side(-0.35, 0.35), relief(0.0, 0.05);
+    const cv::Mat desc = synthetic::random_descriptors(n, rng_);
+    for (int i = 0; i < n; ++i) {
+      const Eigen::Vector3d p(side(rng_), side(rng_), 1.7 + relief(rng_));
+      box_at_start_.add(p, desc.row(i));
+      box_at_return_.add(p + Eigen::Vector3d(kBoxShift, 0, 0), desc.row(i));
+    }
+    box_points_.assign(n, nullptr);
+  }
 
   void make_room(int n) {
     std::uniform_real_distribution<double> angle(0, 2 * M_PI), radius(3.0, 4.0), height(-1.2, 1.2);
@@ -113,19 +135,32 @@ class LoopMap {
   }
 
   void add_keyframe(int k) {
-    const Eigen::Isometry3d X = true_pose(k), G = drift(drift_fraction(k));
-    auto seen = synthetic::visible_points(world_, X);
+    const Eigen::Isometry3d X = true_pose(k), G = drift_of(k);
+    const bool last_kf = k == kLastKeyframe;
+    // What keyframe k sees: the room, and the box while it stands in front of the start or of the return.
+    struct Seen {
+      synthetic::Sighting s;
+      const synthetic::World* world;
+      MapPointPtr* slot;  // the map point it is associated with (null slot content: create one)
+    };
+    std::vector<Seen> seen;
+    std::vector<MapPointPtr> new_box_points(box_at_return_.points.size());
+    for (const auto& s : synthetic::visible_points(world_, X)) seen.push_back({s, &world_, &slot_for(k, s.point)});
+    if (k < kStartKeyframes || last_kf) {
+      const synthetic::World& box = last_kf ? box_at_return_ : box_at_start_;
+      for (const auto& s : synthetic::visible_points(box, X))
+        seen.push_back({s, &box, last_kf ? &new_box_points[s.point] : &box_points_[s.point]});
+    }
     std::normal_distribution<double> pix(0.0, 0.3), rel(0.0, 0.002);
     std::uniform_int_distribution<int> bits(0, 4);
     std::vector<Keypoint> kps;
     cv::Mat desc;
-    const bool last_kf = k == kLastKeyframe;
     const cv::Mat other_place = synthetic::random_descriptors(static_cast<int>(seen.size()), rng_);
     for (std::size_t i = 0; i < seen.size(); ++i) {
-      const auto& s = seen[i];
+      const auto& s = seen[i].s;
       kps.push_back({s.u + pix(rng_), s.v + pix(rng_), s.depth * (1.0 + rel(rng_)), 1.0f, 0});
       desc.push_back(last_kf && last_view_ == LastView::OtherPlace ? other_place.row(static_cast<int>(i)).clone()
-                                                                  : world_.descriptors.row(s.point).clone());
+                                                                  : seen[i].world->descriptors.row(s.point).clone());
       synthetic::flip_bits(desc.row(desc.rows - 1), bits(rng_), rng_);
     }
     if (last_kf && last_view_ == LastView::Scrambled) std::shuffle(kps.begin(), kps.end(), rng_);
@@ -134,9 +169,9 @@ class LoopMap {
     auto kf = std::make_shared<KeyFrame>(map.next_keyframe_id(), f);
     map.add_keyframe(kf);
     for (std::size_t i = 0; i < seen.size(); ++i) {
-      MapPointPtr& mp = slot_for(k, seen[i].point);
+      MapPointPtr& mp = *seen[i].slot;
       if (!mp) {
-        mp = std::make_shared<MapPoint>(map.next_map_point_id(), G.inverse() * world_.points[seen[i].point], kf);
+        mp = std::make_shared<MapPoint>(map.next_map_point_id(), G.inverse() * seen[i].world->points[seen[i].s.point], kf);
         map.add_map_point(mp);
       }
       mp->add_observation(kf, static_cast<int>(i), true);
@@ -294,6 +329,34 @@ TEST(LoopClosing, RecognisedPlaceWithInconsistentGeometryClosesNoLoop) {
   EXPECT_FALSE(closer.process(m.last()));
   EXPECT_TRUE(closer.loops().empty());
   EXPECT_TRUE(m.last()->pose().isApprox(before));
+}
+
+// The box's points outnumber the room's, so the candidate's best alignment is the box's. Matched from the
+// keyframe's own pose, the candidate's neighbourhood agrees with the room: the map is consistent and the loop
+// is refused. Without that check the "loop" drags the keyframe 0.3 m along with the box.
+TEST(LoopClosing, MoverMatchedToItselfClosesNoLoop) {
+  for (const bool check : {true, false}) {
+    SCOPED_TRACE(check ? "own-pose check on" : "own-pose check off");
+    LoopMap m(LastView::MoverMatchedToItself);
+    add_all_but_last(m);
+    LoopConfig cfg = test_loop_config();
+    if (!check) cfg.max_own_pose_share = 0;
+    LoopCloser closer(cfg, optim::KernelConfig{}, m.map, m.places, m.scale());
+    ASSERT_LT(synthetic::pose_error(m.last()->pose(), m.truth.back()).m, 1e-9);
+
+    const bool closed = closer.process(m.last());
+
+    const double error = synthetic::pose_error(m.last()->pose(), m.truth.back()).m;
+    if (check) {
+      EXPECT_FALSE(closed);
+      EXPECT_TRUE(closer.loops().empty());
+      EXPECT_LT(error, 1e-9);
+    } else {
+      ASSERT_TRUE(closed);
+      EXPECT_NEAR(closer.loops().front().correction_m, LoopMap::kBoxShift, 0.05);
+      EXPECT_GT(error, 0.2);
+    }
+  }
 }
 
 TEST(LoopClosing, CandidatesTooRecentAreNotLoops) {
