@@ -1,6 +1,7 @@
 #include "features/feature_extractor.hpp"
 
 #include <cmath>
+#include <stdexcept>
 #include <string>
 
 #include "core/error.hpp"
@@ -27,6 +28,13 @@ FeatureExtractor::FeatureExtractor(const OrbParams& params) : params_(params) {
     sigma2_.push_back(s * s);
     inv_sigma2_.push_back(1.0 / (s * s));
   }
+}
+
+void FeatureExtractor::extract(const cv::Mat& gray, std::vector<cv::KeyPoint>& keypoints, cv::Mat& descriptors,
+                               const cv::Mat& mask) {
+  if (!mask.empty() && (mask.type() != CV_8UC1 || mask.size() != gray.size()))
+    throw std::invalid_argument("FeatureExtractor::extract: the mask must be CV_8UC1 of the image's size");
+  do_extract(gray, keypoints, descriptors, mask);
 }
 
 std::unique_ptr<FeatureExtractor> make_extractor(const OrbParams& params, ExtractorKind kind) {

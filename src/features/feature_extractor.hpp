@@ -27,7 +27,11 @@ class FeatureExtractor {
   /// Keypoints in level-0 pixel coordinates (pt), with octave = pyramid level, angle in degrees [0, 360),
   /// size = patch diameter at level 0; descriptors: CV_8UC1, one 32-byte row per keypoint (rotated BRIEF,
   /// 256 bits). `gray` should be CV_8UC1 (a CV_8UC3 BGR image is converted). Empty input gives no keypoints.
-  virtual void extract(const cv::Mat& gray, std::vector<cv::KeyPoint>& keypoints, cv::Mat& descriptors) = 0;
+  /// `mask` (optional, CV_8UC1, the image's size): keypoints only where it is non-zero, and the whole budget is
+  /// spent there (the semantic filter masks people so the background gets their share). A mask of another size
+  /// or type is an std::invalid_argument.
+  void extract(const cv::Mat& gray, std::vector<cv::KeyPoint>& keypoints, cv::Mat& descriptors,
+               const cv::Mat& mask = cv::Mat());
 
   int n_levels() const { return params_.n_levels; }
   double scale_factor() const { return params_.scale_factor; }
@@ -39,6 +43,9 @@ class FeatureExtractor {
  protected:
   /// Validates the parameters (throws varslam::ConfigError) and fills the per-level tables.
   explicit FeatureExtractor(const OrbParams& params);
+  /// extract() with the mask checked (empty or CV_8UC1 of the image's size).
+  virtual void do_extract(const cv::Mat& gray, std::vector<cv::KeyPoint>& keypoints, cv::Mat& descriptors,
+                          const cv::Mat& mask) = 0;
 
  private:
   OrbParams params_;

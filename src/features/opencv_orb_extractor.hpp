@@ -9,9 +9,10 @@ namespace varslam {
 class OpenCvOrbExtractor final : public FeatureExtractor {
  public:
   explicit OpenCvOrbExtractor(const OrbParams& params);
-  void extract(const cv::Mat& gray, std::vector<cv::KeyPoint>& keypoints, cv::Mat& descriptors) override;
 
  private:
+  void do_extract(const cv::Mat& gray, std::vector<cv::KeyPoint>& keypoints, cv::Mat& descriptors,
+                  const cv::Mat& mask) override;
   cv::Ptr<cv::ORB> orb_;
 };
 

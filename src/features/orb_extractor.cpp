@@ -1,5 +1,6 @@
 #include "features/orb_extractor.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
@@ -26,7 +27,8 @@ OrbExtractor::OrbExtractor(const OrbParams& params) : FeatureExtractor(params), 
   }
 }
 
-void OrbExtractor::extract(const cv::Mat& gray, std::vector<cv::KeyPoint>& keypoints, cv::Mat& descriptors) {
+void OrbExtractor::do_extract(const cv::Mat& gray, std::vector<cv::KeyPoint>& keypoints, cv::Mat& descriptors,
+                              const cv::Mat& mask) {
   keypoints.clear();
   if (gray.empty()) {
     descriptors.create(0, 32, CV_8UC1);
@@ -61,6 +63,14 @@ void OrbExtractor::extract(const cv::Mat& gray, std::vector<cv::KeyPoint>& keypo
     }
     candidates_.clear();
     detect_fast_grid(image, region, grid, candidates_);
+    if (!mask.empty()) {
+      // Masked corners leave before the spreading, so the level's budget goes to the allowed area.
+      std::erase_if(candidates_, [&](const cv::KeyPoint& c) {
+        const int x = std::clamp(static_cast<int>(level_to_base(c.pt.x, input->cols, image.cols)), 0, mask.cols - 1);
+        const int y = std::clamp(static_cast<int>(level_to_base(c.pt.y, input->rows, image.rows)), 0, mask.rows - 1);
+        return mask.at<std::uint8_t>(y, x) == 0;
+      });
+    }
     const std::vector<cv::KeyPoint> kept = spread_keypoints(candidates_, region, budget);
     found.reserve(kept.size());
     for (const cv::KeyPoint& kp : kept) {

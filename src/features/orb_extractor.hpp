@@ -12,7 +12,6 @@ namespace varslam {
 class OrbExtractor final : public FeatureExtractor {
  public:
   explicit OrbExtractor(const OrbParams& params);
-  void extract(const cv::Mat& gray, std::vector<cv::KeyPoint>& keypoints, cv::Mat& descriptors) override;
 
   /// Keypoint budget of each level, proportional to its area (a geometric series of ratio 1/scale^2) and
   /// summing to n_features. Levels that cannot fill theirs pass the rest on to the next level.
@@ -24,6 +23,8 @@ class OrbExtractor final : public FeatureExtractor {
   static constexpr int kGridCell = 30;  // FAST grid cell side [px]
 
  private:
+  void do_extract(const cv::Mat& gray, std::vector<cv::KeyPoint>& keypoints, cv::Mat& descriptors,
+                  const cv::Mat& mask) override;
   struct LevelKeypoint {
     int x, y;  // integer pixel at the level
     float angle;

@@ -97,6 +97,7 @@ SemanticSettings semantic_settings(const Settings& s) {
 
   sec.read("asynchronous", out.asynchronous);
   sec.read("propagate_boxes", out.propagate_boxes);
+  sec.read("mask_extraction", out.mask_extraction);
   return out;
 }
 

@@ -19,6 +19,7 @@
 //     min_exclusive_share: 1    # e.g. 0.2: overlapping boxes also get a person depth from their own part (1 = off)
 //     asynchronous: true        # false: wait for each frame's detections (deterministic)
 //     propagate_boxes: true     # shift stale boxes by optical flow
+//     mask_extraction: true     # extract no keypoints on the people: the budget goes to the background
 #include "io/settings.hpp"
 #include "semantic/detector.hpp"
 #include "semantic/keypoint_filter.hpp"
@@ -30,6 +31,7 @@ struct SemanticSettings {
   FilterConfig filter;
   bool asynchronous = true;
   bool propagate_boxes = true;
+  bool mask_extraction = true;
 };
 
 /// Defaults for missing keys; a key with a wrong type or value is a ConfigError naming the settings file and key.

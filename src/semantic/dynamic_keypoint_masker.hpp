@@ -32,6 +32,10 @@ class DynamicKeypointMasker {
   /// frame.bgr (or gray) feeds the detector, frame.gray the box propagation, frame.depth the filter.
   MaskResult process(const RgbdFrame& frame, const std::vector<cv::KeyPoint>& kps);
 
+  /// The pixels where keypoints are worth extracting on this frame (allowed_pixels of its boxes; empty when there
+  /// are none). Call before process() on the same frame: both use the same boxes, found once.
+  cv::Mat extraction_mask(const RgbdFrame& frame);
+
   /// Blocks until the detector has finished every submitted frame.
   void wait_for_detector() { async_.wait_idle(); }
   std::string detector_name() const { return async_.name(); }
@@ -42,7 +46,12 @@ class DynamicKeypointMasker {
     double timestamp;
     cv::Mat gray;
   };
+  /// Submits the frame to the detector and takes the freshest boxes, moved onto the frame; once per frame.
+  const MaskResult& boxes_for(const RgbdFrame& frame);
+
   SemanticSettings settings_;
+  MaskResult current_;  // boxes of the frame below (keep, stats unset)
+  std::optional<std::pair<std::size_t, double>> current_frame_;  // (index, timestamp)
   AsyncDetector async_;
   std::deque<PastGray> history_;  // recent gray images, to propagate boxes from the image they were found in
 };

@@ -55,7 +55,7 @@ cv::Mat draw_filter_stages(const cv::Mat& bgr, const std::vector<cv::KeyPoint>& 
       ++n_kept;
     }
   }
-  caption(all, "all keypoints: " + std::to_string(kps.size()));
+  caption(all, "extracted keypoints: " + std::to_string(kps.size()));
   caption(boxed, "in person boxes: " + std::to_string(n_in_box));
   caption(kept, "kept after depth test: " + std::to_string(n_kept) + " (x = dropped)");
   cv::Mat out;

@@ -8,7 +8,7 @@
 
 namespace varslam::semantic {
 
-/// all keypoints | keypoints inside boxes (boxes drawn) | keypoints kept after the depth test (dropped in red).
+/// extracted keypoints (with semantic.mask_extraction, none on the people) | keypoints inside boxes (boxes drawn) | keypoints kept after the depth test (dropped in red).
 cv::Mat draw_filter_stages(const cv::Mat& bgr, const std::vector<cv::KeyPoint>& kps, const Detections& boxes,
                            const std::vector<bool>& keep);
 

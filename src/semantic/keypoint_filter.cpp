@@ -148,6 +148,46 @@ cv::Mat distance_to_person(const cv::Mat& depth_m, const cv::Rect& roi, const Pe
   return dist;
 }
 
+namespace {
+
+/// The boxes enlarged and clipped to `size` (empty ones left out, into `rects`) and their person depths (none
+/// without depth).
+std::vector<PersonDepth> enlarged_boxes_and_depths(const Detections& boxes, const cv::Size& size, const cv::Mat& depth_m,
+                                                   const FilterConfig& cfg, std::vector<cv::Rect>& rects) {
+  rects.clear();
+  for (const auto& b : boxes) {
+    const cv::Rect r = enlarge_box(b.box, cfg.box_enlarge, size);
+    if (r.area() > 0) rects.push_back(r);
+  }
+  return depth_m.empty() ? std::vector<PersonDepth>(rects.size()) : estimate_person_depths(depth_m, rects, cfg);
+}
+
+}  // namespace
+
+cv::Mat allowed_pixels(const cv::Size& image_size, const cv::Mat& depth_m, const Detections& boxes,
+                       const FilterConfig& cfg) {
+  if (boxes.empty() || image_size.area() <= 0) return {};
+  const bool has_depth = !depth_m.empty() && depth_m.type() == CV_32FC1 && depth_m.size() == image_size;
+  std::vector<cv::Rect> rects;
+  const std::vector<PersonDepth> person = enlarged_boxes_and_depths(boxes, image_size, has_depth ? depth_m : cv::Mat(),
+                                                                    cfg, rects);
+  cv::Mat1b allowed(image_size, uchar(255));
+  for (std::size_t k = 0; k < rects.size(); ++k) {
+    const cv::Rect& r = rects[k];
+    if (!has_depth || person[k].whole_m <= 0.0f) {  // same rule as filter_keypoints: unknown depth = the person
+      allowed(r).setTo(0);
+      continue;
+    }
+    for (int y = r.y; y < r.y + r.height; ++y) {
+      const float* d = depth_m.ptr<float>(y);
+      uchar* a = allowed.ptr<uchar>(y);
+      for (int x = r.x; x < r.x + r.width; ++x)
+        if (!valid_depth(d[x], cfg) || person[k].matches(d[x], cfg.depth_band_m)) a[x] = 0;
+    }
+  }
+  return allowed;
+}
+
 std::vector<bool> filter_keypoints(const std::vector<cv::KeyPoint>& kps, const cv::Mat& depth_m,
                                    const Detections& boxes, const FilterConfig& cfg, FilterStats* stats) {
   std::vector<bool> keep(kps.size(), true);
@@ -161,12 +201,8 @@ std::vector<bool> filter_keypoints(const std::vector<cv::KeyPoint>& kps, const c
 
   std::vector<BoxDepth> bds;
   std::vector<cv::Rect> rects;
-  for (const auto& b : boxes) {
-    const cv::Rect r = enlarge_box(b.box, cfg.box_enlarge, size);
-    if (r.area() > 0) rects.push_back(r);
-  }
-  const std::vector<PersonDepth> person = has_depth ? estimate_person_depths(depth_m, rects, cfg)
-                                                    : std::vector<PersonDepth>(rects.size());
+  const std::vector<PersonDepth> person = enlarged_boxes_and_depths(boxes, size, has_depth ? depth_m : cv::Mat(), cfg,
+                                                                    rects);
   for (std::size_t k = 0; k < rects.size(); ++k) {
     BoxDepth bd;
     bd.rect = rects[k];

@@ -72,6 +72,11 @@ cv::Mat distance_to_person(const cv::Mat& depth_m, const cv::Rect& roi, const Pe
 std::vector<bool> filter_keypoints(const std::vector<cv::KeyPoint>& kps, const cv::Mat& depth_m,
                                    const Detections& boxes, const FilterConfig& cfg, FilterStats* stats = nullptr);
 
+/// Where keypoints are worth extracting: 0 on the pixels filter_keypoints would drop (inside an enlarged box, at
+/// the person's depth or without depth), 255 elsewhere; CV_8UC1 of `image_size`. Empty when there are no boxes.
+cv::Mat allowed_pixels(const cv::Size& image_size, const cv::Mat& depth_m, const Detections& boxes,
+                       const FilterConfig& cfg);
+
 /// Box enlarged by `fraction` of its size per side and clipped to the image.
 cv::Rect enlarge_box(const cv::Rect2f& box, float fraction, const cv::Size& image_size);
 

@@ -140,6 +140,8 @@ RunSummary run_slam(const Dataset& dataset, const Settings& given_settings, cons
       }
       return r.keep;
     });
+    if (sem.mask_extraction)
+      system.set_extraction_mask([&](const RgbdFrame& f) { return masker->extraction_mask(f); });
   }
 
   // Unregistered depth (separate depth camera): warped into the colour camera on the prefetch thread, before

@@ -39,6 +39,7 @@ class System {
   void finish();
 
   void set_keypoint_filter(KeypointFilterFn fn) { tracker_.set_keypoint_filter(std::move(fn)); }
+  void set_extraction_mask(ExtractionMaskFn fn) { tracker_.set_extraction_mask(std::move(fn)); }
 
   /// Camera-to-world pose of every processed frame that has one (tracked, or re-anchored to a new segment).
   Trajectory camera_trajectory(bool include_lost = false) const;

@@ -45,7 +45,13 @@ Frame Tracker::build_frame(const RgbdFrame& input, FrameTimings& t) {
   auto t0 = Clock::now();
   std::vector<cv::KeyPoint> kps;
   cv::Mat desc;
-  extractor_->extract(input.gray, kps, desc);
+  cv::Mat mask;
+  if (extraction_mask_) {
+    mask = extraction_mask_(input);
+    t.filter_ms = ms_since(t0);
+    t0 = Clock::now();
+  }
+  extractor_->extract(input.gray, kps, desc, mask);
   t.extract_ms = ms_since(t0);
   if (filter_ && !kps.empty()) {
     t0 = Clock::now();
@@ -60,7 +66,7 @@ Frame Tracker::build_frame(const RgbdFrame& input, FrameTimings& t) {
       }
     kps.swap(kept);
     desc = kept_desc;
-    t.filter_ms = ms_since(t0);
+    t.filter_ms += ms_since(t0);
   }
   auto features = make_frame_features(std::move(kps), desc, input.depth, camera_, close_depth_, scale_,
                                       cfg_.tracking.depth_edge_ratio);

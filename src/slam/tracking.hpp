@@ -29,6 +29,8 @@ class KeyframeSink {
 
 /// Decides which keypoints tracking may use (the semantic filter plugs in here). keep[i] per keypoint.
 using KeypointFilterFn = std::function<std::vector<bool>(const RgbdFrame&, const std::vector<cv::KeyPoint>&)>;
+/// Where the extractor may place keypoints on a frame (CV_8UC1, non-zero = allowed; empty = everywhere).
+using ExtractionMaskFn = std::function<cv::Mat(const RgbdFrame&)>;
 
 struct FrameTimings {
   double extract_ms = 0, filter_ms = 0, match_ms = 0, pose_ms = 0, track_ms = 0;
@@ -58,6 +60,7 @@ class Tracker {
 
   TrackOutcome track(const RgbdFrame& input);
   void set_keypoint_filter(KeypointFilterFn fn) { filter_ = std::move(fn); }
+  void set_extraction_mask(ExtractionMaskFn fn) { extraction_mask_ = std::move(fn); }
   /// Keyframes to relocalize against when tracking is lost (none: only the last reference's neighbourhood).
   void set_place_database(const KeyframeDatabase* places) { places_ = places; }
 
@@ -97,6 +100,7 @@ class Tracker {
   std::unique_ptr<FeatureExtractor> extractor_;
   std::shared_ptr<const ScaleInfo> scale_;
   KeypointFilterFn filter_;
+  ExtractionMaskFn extraction_mask_;
   const KeyframeDatabase* places_ = nullptr;
 
   TrackState state_ = TrackState::NotInitialized;

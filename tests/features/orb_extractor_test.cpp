@@ -94,6 +94,34 @@ TEST(OrbExtractor, ReturnsAboutTheBudgetInsideTheImage) {
   for (int n : per_level) EXPECT_GT(n, 0);  // every level contributes
 }
 
+// The semantic filter masks people so the budget goes to the background: nothing inside the mask, and the
+// allowed half gets about the whole budget (not just the half it would get unmasked).
+TEST(OrbExtractor, MaskKeepsKeypointsOutAndSpendsTheBudgetElsewhere) {
+  const cv::Mat img = textured_image(640, 480);
+  cv::Mat1b mask(img.size(), uchar(255));
+  mask(cv::Rect(0, 0, 320, 480)).setTo(0);
+  for (ExtractorKind kind : {ExtractorKind::Ours, ExtractorKind::OpenCV}) {
+    SCOPED_TRACE(kind == ExtractorKind::Ours ? "ours" : "opencv");
+    auto ex = make_extractor(OrbParams{}, kind);
+    Extracted whole = extract(*ex, img), masked;
+    ex->extract(img, masked.keypoints, masked.descriptors, mask);
+    const auto right = [](const std::vector<cv::KeyPoint>& kps) {
+      return std::count_if(kps.begin(), kps.end(), [](const cv::KeyPoint& k) { return k.pt.x >= 320.f; });
+    };
+    EXPECT_EQ(right(masked.keypoints), static_cast<long>(masked.keypoints.size()));  // none on the masked half
+    EXPECT_EQ(masked.descriptors.rows, static_cast<int>(masked.keypoints.size()));
+    EXPECT_GE(masked.keypoints.size(), 0.9 * whole.keypoints.size());
+    EXPECT_GT(right(masked.keypoints), 1.5 * right(whole.keypoints));
+  }
+}
+
+TEST(OrbExtractor, MaskOfAnotherSizeIsRejected) {
+  auto ex = make_extractor(OrbParams{});
+  Extracted e;
+  EXPECT_THROW(ex->extract(textured_image(640, 480), e.keypoints, e.descriptors, cv::Mat1b(240, 320, uchar(255))),
+               std::invalid_argument);
+}
+
 TEST(OrbExtractor, LevelCoordinatesMapBackToTheSameImagePoint) {
   // A bright square on dark: its corners are found at several levels, all at the same level-0 position.
   cv::Mat img(480, 640, CV_8UC1, cv::Scalar(20));

@@ -84,6 +84,25 @@ TEST(DynamicKeypointMasker, SynchronousModeUsesThisFramesBoxes) {
   EXPECT_EQ(r.keep, (std::vector<bool>{false, true, true}));
 }
 
+// Tracking asks for the extraction mask first, then filters: one detection per frame serves both.
+TEST(DynamicKeypointMasker, ExtractionMaskAndFilterShareTheFramesBoxes) {
+  std::atomic<bool> open{true};
+  SemanticSettings s;
+  s.asynchronous = false;
+  DynamicKeypointMasker masker(std::make_unique<ScriptedDetector>(&open), s);
+  const RgbdFrame f = make_frame(2);
+  const cv::Mat mask = masker.extraction_mask(f);
+  ASSERT_FALSE(mask.empty());
+  EXPECT_EQ(mask.at<uchar>(200, 300), 0);    // person
+  EXPECT_EQ(mask.at<uchar>(300, 250), 255);  // wall
+  EXPECT_EQ(mask.at<uchar>(20, 20), 255);    // wall, outside the box
+  const MaskResult r = masker.process(f, {{300, 200, 7}, {250, 300, 7}});
+  EXPECT_EQ(r.keep, (std::vector<bool>{false, true}));
+  EXPECT_EQ(masker.detector_runs(), 1);
+  masker.process(make_frame(3), {});
+  EXPECT_EQ(masker.detector_runs(), 2);
+}
+
 TEST(DynamicKeypointMasker, StaleBoxesArePropagatedToTheCurrentFrame) {
   const std::vector<cv::KeyPoint> kps = {{316, 200, 7}};  // on the person in frame 1, outside its frame-0 box
   for (const bool propagate : {true, false}) {

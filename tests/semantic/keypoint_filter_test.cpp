@@ -57,6 +57,30 @@ TEST(KeypointFilter, DropsPersonKeepsWallBehindDropsNoDepthKeepsOutside) {
   EXPECT_EQ(stats.kept_in_front, 0);
 }
 
+// The extraction mask is the filter's rule per pixel: a keypoint at an allowed pixel is one the filter keeps.
+TEST(KeypointFilter, AllowedPixelsAreWhereTheFilterKeeps) {
+  const Scene scene;
+  const cv::Mat allowed = allowed_pixels(scene.depth.size(), scene.depth, scene.boxes(), FilterConfig{});
+  ASSERT_EQ(allowed.type(), CV_8UC1);
+  ASSERT_EQ(allowed.size(), scene.depth.size());
+  std::vector<cv::KeyPoint> kps;
+  for (int y = 4; y < 480; y += 8)
+    for (int x = 4; x < 640; x += 8) kps.push_back(kp(static_cast<float>(x), static_cast<float>(y)));
+  const auto keep = filter_keypoints(kps, scene.depth, scene.boxes(), FilterConfig{});
+  int masked = 0;
+  for (std::size_t i = 0; i < kps.size(); ++i) {
+    const bool ok = allowed.at<uchar>(cv::Point(kps[i].pt)) != 0;
+    masked += !ok;
+    EXPECT_EQ(ok, static_cast<bool>(keep[i])) << "at " << kps[i].pt;
+  }
+  EXPECT_GT(masked, 200);  // the person and the hole
+  EXPECT_TRUE(allowed_pixels(scene.depth.size(), scene.depth, {}, FilterConfig{}).empty());  // no boxes: no mask
+  // Without depth the whole enlarged box is masked, as the filter drops every keypoint in it.
+  const cv::Mat no_depth = allowed_pixels(scene.depth.size(), cv::Mat(), scene.boxes(), FilterConfig{});
+  EXPECT_EQ(no_depth.at<uchar>(240, 230), 0);
+  EXPECT_EQ(no_depth.at<uchar>(240, 100), 255);
+}
+
 TEST(KeypointFilter, PersonDepthIsTheNearModeEvenWhenTheWallFillsMostOfTheBox) {
   const Scene scene;
   const FilterConfig cfg;
