@@ -1,5 +1,6 @@
 #include "optim/kernel.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <memory>
@@ -46,7 +47,7 @@ const robust::LogPartitionTable& table_for(double tau) {
 
 double fit_alpha(const KernelConfig& cfg, std::span<const double> samples, double current_alpha) {
   if (samples.empty()) return current_alpha;
-  return robust::estimate_alpha(samples, table_for(cfg.tau), cfg.barron_c).alpha;
+  return std::min(cfg.alpha_max, robust::estimate_alpha(samples, table_for(cfg.tau), cfg.barron_c).alpha);
 }
 
 }  // namespace varslam::optim

@@ -18,6 +18,7 @@ struct KernelConfig {
   double barron_alpha = 1.0;  // BarronFixed (also the starting alpha of BarronAdaptive before any fit)
   double barron_c = 1.0;      // scale on whitened residuals
   double tau = 10.0;          // truncation for the log-partition table (BarronAdaptive)
+  double alpha_max = 2.0;     // BarronAdaptive: the fitted alpha is capped here (2 = the grid's top, no cap)
   robust::AlphaFit fit = robust::AlphaFit::ResidualNorm;  // the paper's choice by default
   bool chi2_gates = true;     // ORB-SLAM's outlier gates 5.991 (2 dof) / 7.815 (3 dof) on top of the kernel
 };

@@ -154,6 +154,8 @@ RunSummary run_slam(const Dataset& dataset, const Settings& given_settings, cons
   FramePrefetcher prefetch(dataset, 4, first, count, std::move(prepare));
   std::vector<FrameLog> logs;
   logs.reserve(count);
+  Trajectory live;  // poses as tracking gave them, before later corrections
+  live.reserve(count);
   const auto t_start = Clock::now();
   std::size_t n = 0;
   double first_stamp = 0;
@@ -181,6 +183,7 @@ RunSummary run_slam(const Dataset& dataset, const Settings& given_settings, cons
     log.load_ms = load_ms;
     log.timings = out.timings;
     logs.push_back(log);
+    if (out.live_T_wc) live.push_back({frame->timestamp, *out.live_T_wc});
     ++n;
     if (options.progress && (std::chrono::duration<double>(Clock::now() - last_progress).count() > 1.0 || n == count)) {
       last_progress = Clock::now();
@@ -210,6 +213,7 @@ RunSummary run_slam(const Dataset& dataset, const Settings& given_settings, cons
   const Trajectory traj = system.camera_trajectory();
   write_tum_trajectory(traj, out_dir / "CameraTrajectory.txt");
   write_tum_trajectory(system.keyframe_trajectory(), out_dir / "KeyFrameTrajectory.txt");
+  write_tum_trajectory(live, out_dir / "LiveTrajectory.txt");
   write_map_ply(system.map(), out_dir / "map.ply");
 
   std::vector<double> load, extract, filt, match, pose, track, kf_ms, ba_ms, edge_rejected, n_kps;
@@ -295,6 +299,11 @@ RunSummary run_slam(const Dataset& dataset, const Settings& given_settings, cons
         spdlog::warn("RPE not computed: {}", e.what());
       }
       write_tum_trajectory(ate.aligned_estimate, out_dir / "CameraTrajectory_aligned.txt");
+      if (live.size() >= 2) {
+        // What a live user (a robot) got: each pose when its frame was tracked.
+        const AteResult live_ate = evaluate_ate(gt, live);
+        m["ate_live"] = {{"rmse", live_ate.stats.rmse}, {"max", live_ate.stats.max}, {"pairs", live_ate.stats.count}};
+      }
     } catch (const InputError& e) {
       spdlog::warn("ATE not computed: {}", e.what());
     }

@@ -89,6 +89,7 @@ TrackOutcome Tracker::track(const RgbdFrame& input) {
     }
     record(cur, state_ == TrackState::Ok);
     out.state = state_;
+    if (state_ == TrackState::Ok) out.live_T_wc = cur.T_cw.inverse();
     out.timings.track_ms = ms_since(t_start);
     last_ = cur;
     return out;
@@ -140,6 +141,7 @@ TrackOutcome Tracker::track(const RgbdFrame& input) {
     }
   }
   out.state = state_;
+  if (state_ == TrackState::Ok) out.live_T_wc = cur.T_cw.inverse();
   last_ = cur;
   last_is_keyframe_ = out.keyframe;
   out.timings.track_ms = ms_since(t_start);

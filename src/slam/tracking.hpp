@@ -3,6 +3,7 @@
 // and decides when a frame becomes a keyframe. Owns the current and last frame; reads the map.
 #include <functional>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "core/rgbd_frame.hpp"
@@ -44,6 +45,9 @@ struct TrackOutcome {
   int keypoints = 0;
   int depth_edge_rejected = 0;
   FrameTimings timings;
+  // The pose tracking gave the frame, camera-to-world, as a live user gets it (later BA and loop corrections move
+  // the frame's pose in the final trajectory, not this); empty when the frame was not tracked.
+  std::optional<Eigen::Isometry3d> live_T_wc;
 };
 
 /// Pose of a frame kept relative to its reference keyframe, so later keyframe corrections (BA) move it too.

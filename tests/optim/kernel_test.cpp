@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -83,6 +84,10 @@ TEST(Kernel, AlphaFitDropsWithOutliers) {
   EXPECT_GT(a_clean, 1.5);  // per-component samples of Gaussian noise: close to L2
   EXPECT_LT(a_dirty, a_clean - 1.0);
   EXPECT_DOUBLE_EQ(fit_alpha(k, {}, 0.7), 0.7);  // no samples: keep the current alpha
+  // A cap keeps the fit from going less robust than alpha_max; below it the fit is untouched.
+  k.alpha_max = 1.0;
+  EXPECT_DOUBLE_EQ(fit_alpha(k, clean.samples(), 1.0), 1.0);
+  EXPECT_DOUBLE_EQ(fit_alpha(k, dirty.samples(), 1.0), std::min(1.0, a_dirty));
 }
 
 TEST(Kernel, ResidualNormSamplesAreNorms) {

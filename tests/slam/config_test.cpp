@@ -85,6 +85,21 @@ TEST(SlamConfig, LoopOwnPoseShareIsReadAndChecked) {
   }
 }
 
+TEST(SlamConfig, AlphaMaxIsReadAndChecked) {
+  Settings s = load_settings(write_settings("cfg_amax.yaml", ""));
+  EXPECT_DOUBLE_EQ(slam_config_from(s).mapping.kernel.alpha_max, 1.0);  // capped at pseudo-Huber by default
+  EXPECT_DOUBLE_EQ(slam_config_from(s).tracking.kernel.alpha_max, 2.0);
+  s.root["mapping"]["alpha_max"] = 0.5;
+  EXPECT_DOUBLE_EQ(slam_config_from(s).mapping.kernel.alpha_max, 0.5);
+  s.root["mapping"]["alpha_max"] = 3.0;  // above the grid
+  try {
+    slam_config_from(s);
+    FAIL() << "expected ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("mapping.alpha_max"), std::string::npos) << e.what();
+  }
+}
+
 TEST(SlamConfig, DepthRegistrationIsAutoOrOff) {
   Settings s = load_settings(write_settings("cfg_reg.yaml", ""));
   EXPECT_TRUE(slam_config_from(s).tracking.estimate_registration);
