@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "e2e_support.hpp"
+#include "io/trajectory_io.hpp"
 
 namespace varslam::slam {
 namespace {
@@ -75,6 +76,10 @@ TEST(EndToEnd, StaticSyntheticSceneIsTrackedAccurately) {
   EXPECT_TRUE(fs::exists(s.out_dir / "KeyFrameTrajectory.txt"));
   EXPECT_TRUE(fs::exists(s.out_dir / "map.ply"));
   EXPECT_TRUE(s.metrics.contains("timings"));
+  // The poses as tracking gave them, one per tracked frame, evaluated like the final trajectory.
+  EXPECT_EQ(read_tum_trajectory(s.out_dir / "LiveTrajectory.txt").size(), s.tracked);
+  ASSERT_TRUE(s.metrics.contains("ate_live"));
+  EXPECT_LT(s.metrics.at("ate_live").at("rmse").get<double>(), 0.02);
 }
 
 TEST(EndToEnd, DeterministicModeIsByteIdentical) {
