@@ -45,9 +45,10 @@ const robust::LogPartitionTable& table_for(double tau) {
 }
 }  // namespace
 
-double fit_alpha(const KernelConfig& cfg, std::span<const double> samples, double current_alpha) {
-  if (samples.empty()) return current_alpha;
-  return std::min(cfg.alpha_max, robust::estimate_alpha(samples, table_for(cfg.tau), cfg.barron_c).alpha);
+FittedAlpha fit_alpha(const KernelConfig& cfg, std::span<const double> samples, double current_alpha) {
+  if (samples.empty()) return {current_alpha, current_alpha};
+  const double fitted = robust::estimate_alpha(samples, table_for(cfg.tau), cfg.barron_c).alpha;
+  return {fitted, std::min(cfg.alpha_max, fitted)};
 }
 
 }  // namespace varslam::optim

@@ -117,8 +117,13 @@ class AlphaSamples {
   std::vector<double> samples_;
 };
 
+struct FittedAlpha {
+  double fitted = 2.0;   // the grid search's choice
+  double applied = 2.0;  // what the solver uses: fitted, capped at cfg.alpha_max
+};
+
 /// Grid-search alpha on the samples with the (cached, per tau) log-partition table. Returns the current
-/// alpha unchanged when there are no samples.
-double fit_alpha(const KernelConfig& cfg, std::span<const double> samples, double current_alpha);
+/// alpha unchanged (as both) when there are no samples.
+FittedAlpha fit_alpha(const KernelConfig& cfg, std::span<const double> samples, double current_alpha);
 
 }  // namespace varslam::optim

@@ -198,8 +198,10 @@ BaResult solve_local_ba(const PinholeCamera& cam, BaProblem& problem, const BaCo
       const int dof = state.residual(j, e, &depth);
       samples.add({e, static_cast<std::size_t>(dof)});
     }
-    alpha = fit_alpha(kernel, samples.samples(), alpha);
+    const FittedAlpha fit = fit_alpha(kernel, samples.samples(), alpha);
+    alpha = fit.applied;
     result.alpha_per_iteration.push_back(alpha);
+    result.fitted_alpha_per_iteration.push_back(fit.fitted);
     state.set_alpha(alpha);
   };
   // Re-solving a converged problem with an unchanged alpha is a no-op: skip it (saves Ceres' preprocessing

@@ -195,7 +195,7 @@ PoseOptimResult optimize_pose(const PinholeCamera& cam, Eigen::Isometry3d& T_cw,
         const int dof = whitened_residual(cam, obs[i], T_cw * points_w[i], e, nullptr);
         samples.add({e, static_cast<std::size_t>(dof)});
       }
-      alpha = fit_alpha(kernel, samples.samples(), alpha);
+      alpha = fit_alpha(kernel, samples.samples(), alpha).applied;
     }
     if (ceres_solver)
       result.iterations += ceres_solver->solve(T_cw, obs, active, alpha, cfg.iterations_per_round);

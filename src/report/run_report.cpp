@@ -135,14 +135,18 @@ double json_number(const nlohmann::json& j, std::initializer_list<const char*> k
 
 Plot alpha_per_keyframe_plot(const nlohmann::json& metrics, double t0) {
   Plot plot({"Adaptive kernel: alpha per keyframe (local BA)", "time [s]", "alpha", 800, 420, false, true});
-  std::vector<double> t, a;
+  std::vector<double> t, a, fitted;
+  bool capped = false;
   if (metrics.contains("local_ba") && metrics["local_ba"].is_array()) {
     for (const auto& ba : metrics["local_ba"]) {
       const double alpha = json_number(ba, {"final_alpha"});
       const double stamp = json_number(ba, {"timestamp"});
       if (std::isfinite(alpha) && std::isfinite(stamp)) {
+        const double fit = json_number(ba, {"fitted_alpha"});
         t.push_back(stamp - t0);
         a.push_back(alpha);
+        fitted.push_back(std::isfinite(fit) ? fit : alpha);
+        capped |= fitted.back() != alpha;
       }
     }
   }
@@ -150,6 +154,8 @@ Plot alpha_per_keyframe_plot(const nlohmann::json& metrics, double t0) {
     // Reference: alpha = 2 is the Gaussian (L2) loss, the upper end of the fitted range.
     const double t_end = *std::max_element(t.begin(), t.end());
     plot.add_line("alpha = 2 (L2)", {0.0, t_end}, {2.0, 2.0}, "#bbbbbb");
+    // With mapping.alpha_max below 2 the solver uses the capped value; the fit shows how the residuals changed.
+    if (capped) plot.add_line("fitted alpha (before the cap)", t, fitted, "#e377c2");
     plot.add_line("final alpha", t, a, "#9467bd");
     plot.add_scatter("", std::move(t), std::move(a), "#9467bd");
   }

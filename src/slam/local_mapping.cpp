@@ -327,10 +327,15 @@ void LocalMapper::local_ba(const KeyFramePtr& kf) {
   rec.alpha_per_iteration = res.alpha_per_iteration;
   // The alpha of the last alternation before the chi2 gate is the one that saw the movers; the refine solve
   // re-fits on the gated inliers, which are near-Gaussian by construction.
-  rec.final_alpha = res.alpha_per_iteration.empty()
-                        ? res.final_alpha
-                        : res.alpha_per_iteration[std::min<std::size_t>(res.alpha_per_iteration.size(),
-                                                                         static_cast<std::size_t>(cfg_.ba_outer_iterations)) - 1];
+  rec.final_alpha = rec.fitted_alpha = res.final_alpha;
+  if (!res.alpha_per_iteration.empty()) {
+    const std::size_t last = std::min<std::size_t>(res.alpha_per_iteration.size(),
+                                                   static_cast<std::size_t>(cfg_.ba_outer_iterations)) - 1;
+    rec.final_alpha = rec.fitted_alpha = res.alpha_per_iteration[last];
+    // AlphaStart::SolveFirst: the first solve had no fit, so the fitted list is one shorter.
+    const std::size_t offset = res.alpha_per_iteration.size() - res.fitted_alpha_per_iteration.size();
+    if (last >= offset) rec.fitted_alpha = res.fitted_alpha_per_iteration[last - offset];
+  }
   rec.refine_alpha = res.final_alpha;
   rec.ms = ms_since(t0);
   std::lock_guard lock(stats_mutex_);

@@ -23,6 +23,7 @@ struct BaRecord {
   int keyframes = 0, fixed_keyframes = 0, points = 0, observations = 0, outliers = 0;
   std::vector<double> alpha_per_iteration;
   double final_alpha = 2.0;   // alpha of the last alternation before the outlier gate
+  double fitted_alpha = 2.0;  // the fit behind final_alpha, before mapping.alpha_max capped it
   double refine_alpha = 2.0;  // alpha of the refine solve on the gated inliers
   double ms = 0;
 };

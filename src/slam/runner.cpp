@@ -235,7 +235,7 @@ RunSummary run_slam(const Dataset& dataset, const Settings& given_settings, cons
     ba_json.push_back({{"keyframe", b.keyframe_id}, {"timestamp", b.timestamp}, {"keyframes", b.keyframes},
                        {"fixed_keyframes", b.fixed_keyframes}, {"points", b.points},
                        {"observations", b.observations}, {"outliers", b.outliers},
-                       {"alpha_per_iteration", b.alpha_per_iteration}, {"final_alpha", b.final_alpha}, {"refine_alpha", b.refine_alpha},
+                       {"alpha_per_iteration", b.alpha_per_iteration}, {"final_alpha", b.final_alpha}, {"fitted_alpha", b.fitted_alpha}, {"refine_alpha", b.refine_alpha},
                        {"ms", b.ms}});
   }
   nlohmann::json m;

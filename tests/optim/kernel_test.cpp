@@ -79,15 +79,16 @@ TEST(Kernel, AlphaFitDropsWithOutliers) {
     dirty.add(f);
   }
   EXPECT_EQ(clean.samples().size(), 4000u);
-  const double a_clean = fit_alpha(k, clean.samples(), 1.0);
-  const double a_dirty = fit_alpha(k, dirty.samples(), 1.0);
+  const double a_clean = fit_alpha(k, clean.samples(), 1.0).applied;
+  const double a_dirty = fit_alpha(k, dirty.samples(), 1.0).applied;
   EXPECT_GT(a_clean, 1.5);  // per-component samples of Gaussian noise: close to L2
   EXPECT_LT(a_dirty, a_clean - 1.0);
-  EXPECT_DOUBLE_EQ(fit_alpha(k, {}, 0.7), 0.7);  // no samples: keep the current alpha
+  EXPECT_DOUBLE_EQ(fit_alpha(k, {}, 0.7).applied, 0.7);  // no samples: keep the current alpha
   // A cap keeps the fit from going less robust than alpha_max; below it the fit is untouched.
   k.alpha_max = 1.0;
-  EXPECT_DOUBLE_EQ(fit_alpha(k, clean.samples(), 1.0), 1.0);
-  EXPECT_DOUBLE_EQ(fit_alpha(k, dirty.samples(), 1.0), std::min(1.0, a_dirty));
+  EXPECT_DOUBLE_EQ(fit_alpha(k, clean.samples(), 1.0).applied, 1.0);
+  EXPECT_DOUBLE_EQ(fit_alpha(k, clean.samples(), 1.0).fitted, a_clean);  // the fit itself is reported uncapped
+  EXPECT_DOUBLE_EQ(fit_alpha(k, dirty.samples(), 1.0).applied, std::min(1.0, a_dirty));
 }
 
 TEST(Kernel, ResidualNormSamplesAreNorms) {

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
@@ -138,6 +139,26 @@ TEST(AlphaPlot, UsesFinalAlphaAgainstTimeSinceT0) {
   ASSERT_NE(line, nullptr);
   EXPECT_EQ(line->x, (std::vector<double>{0.5, 1.0}));
   EXPECT_EQ(line->y, (std::vector<double>{1.25, 0.75}));
+}
+
+// With the Local BA alpha capped, the fit itself is drawn too: it is what moves while a mover is in view.
+TEST(AlphaPlot, DrawsTheFitBeforeTheCapOnlyWhenItDiffers) {
+  const auto labels = [](const Plot& p) {
+    std::vector<std::string> out;
+    for (const auto& s : p.series()) out.push_back(s.label);
+    return out;
+  };
+  nlohmann::json m = {{"local_ba", {{{"timestamp", 10.5}, {"final_alpha", 1.0}, {"fitted_alpha", 1.6}},
+                                    {{"timestamp", 11.0}, {"final_alpha", 0.75}, {"fitted_alpha", 0.75}}}}};
+  const Plot capped = alpha_per_keyframe_plot(m, 10.0);
+  const PlotSeries* fit = nullptr;
+  for (const auto& s : capped.series())
+    if (s.label == "fitted alpha (before the cap)") fit = &s;
+  ASSERT_NE(fit, nullptr);
+  EXPECT_EQ(fit->y, (std::vector<double>{1.6, 0.75}));
+  m["local_ba"][0]["fitted_alpha"] = 1.0;
+  const auto uncapped = labels(alpha_per_keyframe_plot(m, 10.0));
+  EXPECT_EQ(std::count(uncapped.begin(), uncapped.end(), "fitted alpha (before the cap)"), 0);
 }
 
 TEST(TimingPlot, MedianAndP95PerStageInPipelineOrder) {
