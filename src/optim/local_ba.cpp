@@ -293,16 +293,23 @@ BaResult solve_local_ba(const PinholeCamera& cam, BaProblem& problem, const BaCo
   return result;
 }
 
+KeyframeObservationCounts count_keyframe_observations(const BaProblem& problem,
+                                                      const std::vector<bool>& outlier_observation) {
+  KeyframeObservationCounts c{std::vector<int>(problem.keyframes.size()), std::vector<int>(problem.keyframes.size())};
+  for (std::size_t o = 0; o < problem.observations.size(); ++o) {
+    const auto k = static_cast<std::size_t>(problem.observations[o].keyframe);
+    ++c.total[k];
+    if (outlier_observation[o]) ++c.flagged[k];
+  }
+  return c;
+}
+
 std::vector<int> keep_diverged_keyframes(BaProblem& problem, const std::vector<Eigen::Isometry3d>& before,
                                          std::vector<bool>& outlier_observation) {
-  std::vector<int> total(problem.keyframes.size()), bad(problem.keyframes.size());
-  for (std::size_t o = 0; o < problem.observations.size(); ++o) {
-    ++total[static_cast<std::size_t>(problem.observations[o].keyframe)];
-    if (outlier_observation[o]) ++bad[static_cast<std::size_t>(problem.observations[o].keyframe)];
-  }
+  const KeyframeObservationCounts counts = count_keyframe_observations(problem, outlier_observation);
   std::vector<int> reset;
   for (std::size_t i = 0; i < problem.keyframes.size(); ++i) {
-    if (problem.keyframes[i].fixed || 2 * bad[i] <= total[i]) continue;
+    if (problem.keyframes[i].fixed || 2 * counts.flagged[i] <= counts.total[i]) continue;
     problem.keyframes[i].T_cw = before[i];
     reset.push_back(static_cast<int>(i));
   }

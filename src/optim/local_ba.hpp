@@ -82,6 +82,13 @@ struct BaResult {
 /// Throws std::invalid_argument on an observation indexing a missing keyframe or point.
 BaResult solve_local_ba(const PinholeCamera& cam, BaProblem& problem, const BaConfig& cfg);
 
+/// Per problem keyframe: how many observations it has and how many of them `outlier_observation` flags.
+struct KeyframeObservationCounts {
+  std::vector<int> total, flagged;
+};
+KeyframeObservationCounts count_keyframe_observations(const BaProblem& problem,
+                                                      const std::vector<bool>& outlier_observation);
+
 /// A free keyframe that the solve left with more than half of its observations flagged as outliers has
 /// diverged (seen: 220 of 284, moved 1.46 m, in a walking scene): its pose goes back to `before` (one pose per
 /// problem keyframe) and its observations are unflagged. Returns the indices of the keyframes reset.

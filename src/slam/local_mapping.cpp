@@ -304,18 +304,14 @@ void LocalMapper::local_ba(const KeyFramePtr& kf) {
   for (const auto& k : ba.keyframes) before.push_back(k->pose());
   if (spdlog::should_log(spdlog::level::debug)) {
     // Large moves of a keyframe away from its tracked pose are how a bad Local BA shows (see mapping.alpha_max).
-    std::vector<int> total(problem.keyframes.size()), flagged(problem.keyframes.size());
-    for (std::size_t o = 0; o < problem.observations.size(); ++o) {
-      const auto k = static_cast<std::size_t>(problem.observations[o].keyframe);
-      ++total[k];
-      flagged[k] += res.outlier_observation[o];
-    }
+    const optim::KeyframeObservationCounts counts =
+        optim::count_keyframe_observations(problem, res.outlier_observation);
     for (std::size_t i = 0; i < problem.keyframes.size(); ++i) {
       const double moved =
           (problem.keyframes[i].T_cw.inverse().translation() - before[i].inverse().translation()).norm();
       if (!problem.keyframes[i].fixed && moved > 0.03)
         spdlog::debug("Local BA for keyframe {}: keyframe {} moved {:.3f} m, {} of {} observations flagged", kf->id(),
-                      ba.keyframes[i]->id(), moved, flagged[i], total[i]);
+                      ba.keyframes[i]->id(), moved, counts.flagged[i], counts.total[i]);
     }
   }
   for (const int i : optim::keep_diverged_keyframes(problem, before, res.outlier_observation))
