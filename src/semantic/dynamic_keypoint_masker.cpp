@@ -26,9 +26,9 @@ DynamicKeypointMasker::DynamicKeypointMasker(const SemanticSettings& settings)
 DynamicKeypointMasker::DynamicKeypointMasker(std::unique_ptr<Detector> detector, const SemanticSettings& settings)
     : settings_(settings), async_(std::move(detector)) {}
 
-const MaskResult& DynamicKeypointMasker::boxes_for(const RgbdFrame& frame) {
+void DynamicKeypointMasker::boxes_for(const RgbdFrame& frame) {
   const std::pair<std::size_t, double> id{frame.index, frame.timestamp};
-  if (current_frame_ == id) return current_;
+  if (current_frame_ == id) return;
   current_frame_ = id;
   const cv::Mat& image = frame.bgr.empty() ? frame.gray : frame.bgr;
   async_.submit(image, frame.timestamp);
@@ -56,19 +56,20 @@ const MaskResult& DynamicKeypointMasker::boxes_for(const RgbdFrame& frame) {
       }
     }
   }
+  people_ = locate_people(image.size(), frame.depth, out.boxes, settings_.filter);
   current_ = std::move(out);
-  return current_;
 }
 
 cv::Mat DynamicKeypointMasker::extraction_mask(const RgbdFrame& frame) {
-  const MaskResult& r = boxes_for(frame);
+  boxes_for(frame);
   const cv::Mat& image = frame.gray.empty() ? frame.bgr : frame.gray;
-  return allowed_pixels(image.size(), frame.depth, r.boxes, settings_.filter);
+  return allowed_pixels(image.size(), frame.depth, people_, settings_.filter);
 }
 
 MaskResult DynamicKeypointMasker::process(const RgbdFrame& frame, const std::vector<cv::KeyPoint>& kps) {
-  MaskResult out = boxes_for(frame);
-  out.keep = filter_keypoints(kps, frame.depth, out.boxes, settings_.filter, &out.stats);
+  boxes_for(frame);
+  MaskResult out = current_;
+  out.keep = filter_keypoints(kps, frame.depth, people_, settings_.filter, &out.stats);
   return out;
 }
 

@@ -46,11 +46,13 @@ class DynamicKeypointMasker {
     double timestamp;
     cv::Mat gray;
   };
-  /// Submits the frame to the detector and takes the freshest boxes, moved onto the frame; once per frame.
-  const MaskResult& boxes_for(const RgbdFrame& frame);
+  /// Submits the frame to the detector, takes the freshest boxes, moves them onto the frame and locates the people
+  /// in its depth; once per frame (current_, people_).
+  void boxes_for(const RgbdFrame& frame);
 
   SemanticSettings settings_;
-  MaskResult current_;  // boxes of the frame below (keep, stats unset)
+  MaskResult current_;    // boxes of the frame below (keep, stats unset)
+  PersonRegions people_;  // the same boxes, enlarged, with their person depths
   std::optional<std::pair<std::size_t, double>> current_frame_;  // (index, timestamp)
   AsyncDetector async_;
   std::deque<PastGray> history_;  // recent gray images, to propagate boxes from the image they were found in

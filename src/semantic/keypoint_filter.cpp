@@ -148,33 +148,32 @@ cv::Mat distance_to_person(const cv::Mat& depth_m, const cv::Rect& roi, const Pe
   return dist;
 }
 
-namespace {
-
-/// The boxes enlarged and clipped to `size` (empty ones left out, into `rects`) and their person depths (none
-/// without depth).
-std::vector<PersonDepth> enlarged_boxes_and_depths(const Detections& boxes, const cv::Size& size, const cv::Mat& depth_m,
-                                                   const FilterConfig& cfg, std::vector<cv::Rect>& rects) {
-  rects.clear();
+PersonRegions locate_people(const cv::Size& image_size, const cv::Mat& depth_m, const Detections& boxes,
+                            const FilterConfig& cfg) {
+  PersonRegions people;
+  people.has_depth = !depth_m.empty() && depth_m.type() == CV_32FC1 && depth_m.size() == image_size;
   for (const auto& b : boxes) {
-    const cv::Rect r = enlarge_box(b.box, cfg.box_enlarge, size);
-    if (r.area() > 0) rects.push_back(r);
+    const cv::Rect r = enlarge_box(b.box, cfg.box_enlarge, image_size);
+    if (r.area() > 0) people.rects.push_back(r);
   }
-  return depth_m.empty() ? std::vector<PersonDepth>(rects.size()) : estimate_person_depths(depth_m, rects, cfg);
+  people.persons = people.has_depth ? estimate_person_depths(depth_m, people.rects, cfg)
+                                    : std::vector<PersonDepth>(people.rects.size());
+  return people;
 }
-
-}  // namespace
 
 cv::Mat allowed_pixels(const cv::Size& image_size, const cv::Mat& depth_m, const Detections& boxes,
                        const FilterConfig& cfg) {
-  if (boxes.empty() || image_size.area() <= 0) return {};
-  const bool has_depth = !depth_m.empty() && depth_m.type() == CV_32FC1 && depth_m.size() == image_size;
-  std::vector<cv::Rect> rects;
-  const std::vector<PersonDepth> person = enlarged_boxes_and_depths(boxes, image_size, has_depth ? depth_m : cv::Mat(),
-                                                                    cfg, rects);
+  return allowed_pixels(image_size, depth_m, locate_people(image_size, depth_m, boxes, cfg), cfg);
+}
+
+cv::Mat allowed_pixels(const cv::Size& image_size, const cv::Mat& depth_m, const PersonRegions& people,
+                       const FilterConfig& cfg) {
+  if (people.rects.empty() || image_size.area() <= 0) return {};
   cv::Mat1b allowed(image_size, uchar(255));
-  for (std::size_t k = 0; k < rects.size(); ++k) {
-    const cv::Rect& r = rects[k];
-    if (!has_depth || person[k].whole_m <= 0.0f) {  // same rule as filter_keypoints: unknown depth = the person
+  for (std::size_t k = 0; k < people.rects.size(); ++k) {
+    const cv::Rect r = people.rects[k] & cv::Rect(0, 0, image_size.width, image_size.height);
+    const PersonDepth& person = people.persons[k];
+    if (!people.has_depth || person.whole_m <= 0.0f) {  // same rule as filter_keypoints: unknown depth = the person
       allowed(r).setTo(0);
       continue;
     }
@@ -182,7 +181,7 @@ cv::Mat allowed_pixels(const cv::Size& image_size, const cv::Mat& depth_m, const
       const float* d = depth_m.ptr<float>(y);
       uchar* a = allowed.ptr<uchar>(y);
       for (int x = r.x; x < r.x + r.width; ++x)
-        if (!valid_depth(d[x], cfg) || person[k].matches(d[x], cfg.depth_band_m)) a[x] = 0;
+        if (!valid_depth(d[x], cfg) || person.matches(d[x], cfg.depth_band_m)) a[x] = 0;
     }
   }
   return allowed;
@@ -190,23 +189,26 @@ cv::Mat allowed_pixels(const cv::Size& image_size, const cv::Mat& depth_m, const
 
 std::vector<bool> filter_keypoints(const std::vector<cv::KeyPoint>& kps, const cv::Mat& depth_m,
                                    const Detections& boxes, const FilterConfig& cfg, FilterStats* stats) {
+  // Without a depth image there is no image size to clip the boxes to.
+  const bool has_depth = !depth_m.empty() && depth_m.type() == CV_32FC1;
+  const cv::Size size = has_depth ? depth_m.size() : cv::Size(INT_MAX / 2, INT_MAX / 2);
+  return filter_keypoints(kps, depth_m, locate_people(size, depth_m, boxes, cfg), cfg, stats);
+}
+
+std::vector<bool> filter_keypoints(const std::vector<cv::KeyPoint>& kps, const cv::Mat& depth_m,
+                                   const PersonRegions& people, const FilterConfig& cfg, FilterStats* stats) {
   std::vector<bool> keep(kps.size(), true);
   FilterStats s;
-  if (boxes.empty()) {
+  if (people.rects.empty()) {
     if (stats) *stats = s;
     return keep;
   }
-  const bool has_depth = !depth_m.empty() && depth_m.type() == CV_32FC1;
-  const cv::Size size = has_depth ? depth_m.size() : cv::Size(INT_MAX / 2, INT_MAX / 2);
-
+  const bool has_depth = people.has_depth;
   std::vector<BoxDepth> bds;
-  std::vector<cv::Rect> rects;
-  const std::vector<PersonDepth> person = enlarged_boxes_and_depths(boxes, size, has_depth ? depth_m : cv::Mat(), cfg,
-                                                                    rects);
-  for (std::size_t k = 0; k < rects.size(); ++k) {
+  for (std::size_t k = 0; k < people.rects.size(); ++k) {
     BoxDepth bd;
-    bd.rect = rects[k];
-    bd.person = person[k];
+    bd.rect = people.rects[k];
+    bd.person = people.persons[k];
     if (cfg.silhouette_margin_px > 0.0f && bd.person.whole_m > 0.0f)
       bd.dist_to_person = distance_to_person(depth_m, bd.rect, bd.person, cfg);
     bds.push_back(bd);

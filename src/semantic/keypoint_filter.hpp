@@ -66,15 +66,33 @@ std::vector<PersonDepth> estimate_person_depths(const cv::Mat& depth_m, const st
 cv::Mat distance_to_person(const cv::Mat& depth_m, const cv::Rect& roi, const PersonDepth& person,
                            const FilterConfig& cfg);
 
+/// The people of one frame as both the filter and the extraction mask see them: each detection's box enlarged and
+/// clipped to the image, with its person depth. Computed once per frame and shared by the two.
+struct PersonRegions {
+  std::vector<cv::Rect> rects;       // enlarged boxes, clipped; empty ones left out
+  std::vector<PersonDepth> persons;  // one per rect; whole_m == 0: unknown (the box has no valid depth)
+  bool has_depth = false;            // depth_m was usable (CV_32FC1 of the image's size)
+};
+
+/// Locates the people of `boxes` on a frame of `image_size` (depth_m may be empty: then no person depth is known).
+PersonRegions locate_people(const cv::Size& image_size, const cv::Mat& depth_m, const Detections& boxes,
+                            const FilterConfig& cfg);
+
 /// keep[i] for each keypoint. Inside a box: drop if |d - person| <= band or d has no valid depth; keep if
 /// d > person + band (background). Keypoints nearer than person - band are occluders in front of the person and
 /// are kept unless they lie within the silhouette margin of the person's pixels. Outside all boxes: keep. depth_m may be empty (then every keypoint in a box counts as no-depth).
 std::vector<bool> filter_keypoints(const std::vector<cv::KeyPoint>& kps, const cv::Mat& depth_m,
                                    const Detections& boxes, const FilterConfig& cfg, FilterStats* stats = nullptr);
+/// Same, on people already located on this frame (depth_m: the one they were located with).
+std::vector<bool> filter_keypoints(const std::vector<cv::KeyPoint>& kps, const cv::Mat& depth_m,
+                                   const PersonRegions& people, const FilterConfig& cfg, FilterStats* stats = nullptr);
 
 /// Where keypoints are worth extracting: 0 on the pixels filter_keypoints would drop (inside an enlarged box, at
 /// the person's depth or without depth), 255 elsewhere; CV_8UC1 of `image_size`. Empty when there are no boxes.
 cv::Mat allowed_pixels(const cv::Size& image_size, const cv::Mat& depth_m, const Detections& boxes,
+                       const FilterConfig& cfg);
+/// Same, on people already located on this frame of `image_size` (depth_m: the one they were located with).
+cv::Mat allowed_pixels(const cv::Size& image_size, const cv::Mat& depth_m, const PersonRegions& people,
                        const FilterConfig& cfg);
 
 /// Box enlarged by `fraction` of its size per side and clipped to the image.

@@ -74,11 +74,39 @@ TEST(KeypointFilter, AllowedPixelsAreWhereTheFilterKeeps) {
     EXPECT_EQ(ok, static_cast<bool>(keep[i])) << "at " << kps[i].pt;
   }
   EXPECT_GT(masked, 200);  // the person and the hole
-  EXPECT_TRUE(allowed_pixels(scene.depth.size(), scene.depth, {}, FilterConfig{}).empty());  // no boxes: no mask
+  EXPECT_TRUE(allowed_pixels(scene.depth.size(), scene.depth, Detections{}, FilterConfig{}).empty());  // no boxes: no mask
   // Without depth the whole enlarged box is masked, as the filter drops every keypoint in it.
   const cv::Mat no_depth = allowed_pixels(scene.depth.size(), cv::Mat(), scene.boxes(), FilterConfig{});
   EXPECT_EQ(no_depth.at<uchar>(240, 230), 0);
   EXPECT_EQ(no_depth.at<uchar>(240, 100), 255);
+}
+
+// The masker locates the people once per frame and hands the result to both the mask and the filter: that must
+// decide exactly as the per-call functions do, also for a box reaching past the image border and without depth.
+TEST(KeypointFilter, PeopleLocatedOnceDecideAsTheBoxesDo) {
+  const Scene scene;
+  Detections boxes = scene.boxes();
+  Detection edge;
+  edge.label = "person";
+  edge.box = cv::Rect2f(560, 300, 120, 220);  // past the right and bottom borders
+  boxes.push_back(edge);
+  std::vector<cv::KeyPoint> kps;
+  for (int y = 3; y < 480; y += 6)
+    for (int x = 3; x < 640; x += 6) kps.push_back(kp(static_cast<float>(x), static_cast<float>(y)));
+  const FilterConfig cfg;
+  for (const cv::Mat& depth : {scene.depth, cv::Mat()}) {
+    const PersonRegions people = locate_people(scene.depth.size(), depth, boxes, cfg);
+    ASSERT_EQ(people.rects.size(), 2u);
+    EXPECT_EQ(people.has_depth, !depth.empty());
+    FilterStats once, per_call;
+    EXPECT_EQ(filter_keypoints(kps, depth, people, cfg, &once), filter_keypoints(kps, depth, boxes, cfg, &per_call));
+    EXPECT_EQ(once.dropped, per_call.dropped);
+    EXPECT_GT(once.dropped, 100);
+    const cv::Mat a = allowed_pixels(scene.depth.size(), depth, people, cfg);
+    const cv::Mat b = allowed_pixels(scene.depth.size(), depth, boxes, cfg);
+    ASSERT_EQ(a.size(), b.size());
+    EXPECT_EQ(cv::countNonZero(a != b), 0);
+  }
 }
 
 TEST(KeypointFilter, PersonDepthIsTheNearModeEvenWhenTheWallFillsMostOfTheBox) {
@@ -129,7 +157,7 @@ TEST(KeypointFilter, NoBoxesKeepsAll) {
   const Scene scene;
   FilterStats stats;
   stats.dropped = 99;
-  const auto keep = filter_keypoints({kp(320, 200), kp(1, 1)}, scene.depth, {}, FilterConfig{}, &stats);
+  const auto keep = filter_keypoints({kp(320, 200), kp(1, 1)}, scene.depth, Detections{}, FilterConfig{}, &stats);
   EXPECT_EQ(keep, (std::vector<bool>{true, true}));
   EXPECT_EQ(stats.dropped, 0);
   EXPECT_EQ(stats.in_boxes, 0);
