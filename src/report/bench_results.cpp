@@ -2,11 +2,13 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <limits>
 #include <map>
 #include <sstream>
+#include <tuple>
 
 #include "core/error.hpp"
 #include "report/html.hpp"
@@ -107,6 +109,71 @@ CellMean mean_of(const std::vector<const RunRecord*>& records) {
   return m;
 }
 
+namespace {
+
+// Mean ATE RMSE of a scenario over the (path, seed) pairs that also have a static run with an ATE, and the
+// static mean over the same pairs: a ratio of two means over different seeds would compare different scenes.
+struct PairedMeans {
+  double dynamic_m = 0, static_m = 0;
+  std::size_t pairs = 0, runs = 0;
+};
+
+std::string ratio_cell(const PairedMeans& p) {
+  if (p.pairs == 0 || p.static_m <= 0) return p.runs == 0 ? "" : "fail";
+  std::string s = format_number(p.dynamic_m / p.static_m, 2);
+  if (p.pairs < p.runs) s += "*";
+  return s;
+}
+
+}  // namespace
+
+std::string render_static_ratio_table(const std::vector<RunRecord>& records, const std::vector<std::string>& configs) {
+  // static ATE per (path, config, seed)
+  std::map<std::tuple<std::string, std::string, std::uint64_t>, double> stat;
+  std::vector<std::string> scenarios, paths;
+  auto note = [](std::vector<std::string>& v, const std::string& x) {
+    if (std::find(v.begin(), v.end(), x) == v.end()) v.push_back(x);
+  };
+  for (const auto& r : records) {
+    if (r.scenario == "static" && r.ok && std::isfinite(r.figures.ate_rmse_m))
+      stat[{r.path_name, r.config, r.seed}] = r.figures.ate_rmse_m;
+    if (r.scenario != "static" && r.scenario != "real") note(scenarios, r.scenario);
+    if (r.scenario != "real") note(paths, r.path_name);
+  }
+  if (stat.empty() || scenarios.empty()) return {};
+  auto paired = [&](const std::string& scenario, const std::string& path, const std::string& config) {
+    PairedMeans p;
+    for (const auto& r : records) {
+      if (r.scenario != scenario || r.config != config || (!path.empty() && r.path_name != path)) continue;
+      ++p.runs;
+      const auto s = stat.find({r.path_name, r.config, r.seed});
+      if (!r.ok || !std::isfinite(r.figures.ate_rmse_m) || s == stat.end()) continue;
+      p.dynamic_m += r.figures.ate_rmse_m;
+      p.static_m += s->second;
+      ++p.pairs;
+    }
+    return p;
+  };
+  std::ostringstream t;
+  t << "| scenario | path |";
+  for (const auto& c : configs) t << ' ' << c << " |";
+  t << "\n|---|---|";
+  for (std::size_t i = 0; i < configs.size(); ++i) t << "--:|";
+  t << '\n';
+  for (const auto& sc : scenarios) {
+    std::vector<std::string> rows = paths;
+    rows.push_back("");  // all paths
+    for (const auto& path : rows) {
+      if (std::none_of(configs.begin(), configs.end(), [&](const auto& c) { return paired(sc, path, c).runs > 0; }))
+        continue;
+      t << "| " << sc << " | " << (path.empty() ? "all" : path) << " |";
+      for (const auto& c : configs) t << ' ' << ratio_cell(paired(sc, path, c)) << " |";
+      t << '\n';
+    }
+  }
+  return t.str();
+}
+
 std::string render_markdown_tables(const std::vector<RunRecord>& records, const TableOptions& o) {
   std::vector<Group> per_scenario, per_path;
   auto find_or_add = [](std::vector<Group>& groups, const std::string& scenario, const std::string& path) -> Group& {
@@ -129,6 +196,12 @@ std::string render_markdown_tables(const std::vector<RunRecord>& records, const 
   md << render_table(per_scenario, o, false);
   md << "\nPer scenario and camera path (mean over seeds):\n\n";
   md << render_table(per_path, o, true);
+  const std::string ratios = render_static_ratio_table(records, o.configs);
+  if (!ratios.empty()) {
+    md << "\nATE RMSE against the static scene along the same path (mean over the seeds both have; 1 = the movers "
+          "cost nothing; `*`: some runs had no static partner or failed):\n\n";
+    md << ratios;
+  }
   return md.str();
 }
 

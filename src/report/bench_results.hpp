@@ -56,6 +56,11 @@ struct TableOptions {
 /// tracking median [ms]. Rows keep the order in which scenarios and paths first appear in `records`.
 std::string render_markdown_tables(const std::vector<RunRecord>& records, const TableOptions& options);
 
+/// Each dynamic scenario's ATE RMSE over the static scenario's along the same path, per configuration: one row
+/// per scenario x path and one over all paths. Sums over the (path, seed) pairs where both have an ATE. Empty
+/// when there are no static runs.
+std::string render_static_ratio_table(const std::vector<RunRecord>& records, const std::vector<std::string>& configs);
+
 /// Replaces the text between the marker lines <!-- BENCHMARK-TABLE:BEGIN --> and <!-- BENCHMARK-TABLE:END -->
 /// in `document` with `generated`; throws InputError (naming `document_name`) when the markers are missing.
 std::string replace_between_markers(const std::string& document, const std::string& generated,

@@ -74,6 +74,26 @@ TEST(MarkdownTables, PeerColumnGroup) {
   EXPECT_NE(md.find("| 3.00 | 6.00 | 10.0 |"), std::string::npos) << md;
 }
 
+// The semantic filter's target (walking within 1.5x of static along the same path) is this table's figure.
+TEST(MarkdownTables, RatioToStaticPairsSeedsAlongTheSamePath) {
+  std::vector<RunRecord> r = {
+      rec("walking", "pa", 1, "full", 0.03), rec("walking", "pa", 2, "full", 0.03),
+      rec("static", "pa", 1, "full", 0.02),  rec("static", "pa", 2, "full", 0.01),
+      rec("walking", "pb", 1, "full", 0.03), rec("walking", "pb", 2, "full", 0.04),  // seed 2 has no static run
+      rec("static", "pb", 1, "full", 0.01),  rec("walking", "pb", 1, "huber", 0.05),
+      rec("static", "pb", 1, "huber", 0.02), rec("static", "pb", 3, "full", 0.5),  // no walking partner: unused
+      rec("real", "kitchen", 0, "full", 0.05)};
+  const std::string t = render_static_ratio_table(r, {"huber", "full"});
+  EXPECT_NE(t.find("| scenario | path | huber | full |"), std::string::npos) << t;
+  EXPECT_NE(t.find("| walking | pa |  | 2.00 |"), std::string::npos) << t;     // (3 + 3) / (2 + 1)
+  EXPECT_NE(t.find("| walking | pb | 2.50 | 3.00* |"), std::string::npos) << t;  // 3 / 1, one run unpaired
+  EXPECT_NE(t.find("| walking | all | 2.50 | 2.25* |"), std::string::npos) << t;  // (3 + 3 + 3) / (2 + 1 + 1)
+  EXPECT_EQ(t.find("static |"), std::string::npos) << t;  // static is the reference, not a row
+  EXPECT_EQ(t.find("kitchen"), std::string::npos) << t;
+  EXPECT_NE(render_markdown_tables(r, {{"huber", "full"}, false, "peer"}).find(t), std::string::npos);
+  EXPECT_TRUE(render_static_ratio_table({rec("walking", "pa", 1, "full", 0.03)}, {"full"}).empty());  // no static
+}
+
 TEST(Markers, ReplacesOnlyTheGeneratedBlock) {
   const std::string doc = std::string("# B\nintro\n") + kTableBeginMarker + "\nold table\n" + kTableEndMarker + "\nafter\n";
   const std::string out = replace_between_markers(doc, "new table", "B.md");
