@@ -85,9 +85,9 @@ void widen_to(AxisTicks& axis, double units, int target_ticks) {
   }
 }
 
-double text_width(const std::string& s, double size) { return 0.62 * size * static_cast<double>(s.size()); }
-
 }  // namespace
+
+double text_width(const std::string& s, double size) { return 0.62 * size * static_cast<double>(s.size()); }
 
 Rgb parse_color(const std::string& color) {
   Rgb c;
@@ -212,12 +212,19 @@ void draw_plot(const Plot& plot, PlotCanvas& canvas) {
     canvas.polyline({{left, py(v)}, {left + pw, py(v)}}, "#e5e5e5", 1.0);
     canvas.text({left - 7, py(v) + 4}, format_tick(v, ay.step), kTickFont, TextAnchor::End, false, false);
   }
+  // Category names wider than their slot alternate between two rows, so neighbours do not overlap.
+  bool stagger = false;
+  if (categories && !ax.values.empty()) {
+    const double slot = pw / static_cast<double>(ax.values.size());
+    for (const auto& c : plot.x_categories()) stagger = stagger || text_width(c, kTickFont) > slot - 4.0;
+  }
   for (std::size_t k = 0; k < ax.values.size(); ++k) {
     const double v = ax.values[k];
     if (!categories) canvas.polyline({{px(v), top}, {px(v), top + ph}}, "#e5e5e5", 1.0);
-    canvas.polyline({{px(v), top + ph}, {px(v), top + ph + 5}}, "#333333", 1.0);
+    const double row = stagger && k % 2 == 1 ? kTickFont + 2.0 : 0.0;
+    canvas.polyline({{px(v), top + ph}, {px(v), top + ph + 5 + row}}, "#333333", 1.0);
     const std::string label = categories ? plot.x_categories()[k] : format_tick(v, ax.step);
-    canvas.text({px(v), top + ph + 19}, label, kTickFont, TextAnchor::Middle, false, false);
+    canvas.text({px(v), top + ph + 19 + row}, label, kTickFont, TextAnchor::Middle, false, false);
   }
   if (ay.lo < 0.0 && ay.hi > 0.0 && bars.groups > 0) {
     canvas.polyline({{left, py(0)}, {left + pw, py(0)}}, "#333333", 1.0);

@@ -44,6 +44,9 @@ AxisTicks nice_axis(double data_min, double data_max, int target_ticks);
 /// Tick label with as many decimals as the step needs ("0.25", "10", "-1.5").
 std::string format_tick(double value, double step);
 
+/// Estimated width in pixels of `s` at font `size` (sans-serif average; used to keep labels apart).
+double text_width(const std::string& s, double size);
+
 void draw_plot(const Plot& plot, PlotCanvas& canvas);
 
 }  // namespace varslam

@@ -131,6 +131,35 @@ TEST(SvgPlot, CategoryBarsAreLabelledAndGrouped) {
   write_plot(plot, dir / "bars.svg");
 }
 
+// Long category names (the benchmark's scenario names) must not run into each other: crowded labels alternate
+// between two rows, short ones stay on one.
+TEST(SvgPlot, CrowdedCategoryLabelsDoNotOverlap) {
+  auto label_boxes = [](const std::vector<std::string>& names) {
+    Plot plot({"", "", "ms", 640, 400, false, true});
+    plot.add_category_bars("a", names, std::vector<double>(names.size(), 1.0));
+    const std::string svg = render_svg(plot);
+    std::vector<std::pair<double, double>> at;  // (x, y) of each category label, in order
+    for (const auto& n : names) {
+      const std::regex re("<text x=\"([0-9.]+)\" y=\"([0-9.]+)\"[^>]*>" + n + "</text>");
+      std::smatch m;
+      EXPECT_TRUE(std::regex_search(svg, m, re)) << n;
+      at.emplace_back(std::stod(m[1]), std::stod(m[2]));
+    }
+    return at;
+  };
+  const std::vector<std::string> longs = {"static", "walking", "unknown_box", "obstructing_box", "balloon", "mixed",
+                                          "7scenes_redkitchen"};
+  const auto at = label_boxes(longs);
+  for (std::size_t k = 0; k + 1 < at.size(); ++k) {
+    const double half_widths = text_width(longs[k], 12.0) / 2 + text_width(longs[k + 1], 12.0) / 2;
+    const bool apart = at[k + 1].first - at[k].first >= half_widths || std::abs(at[k + 1].second - at[k].second) >= 12;
+    EXPECT_TRUE(apart) << longs[k] << " / " << longs[k + 1];
+  }
+  const auto short_at = label_boxes({"orb", "match", "ba"});
+  EXPECT_DOUBLE_EQ(short_at[0].second, short_at[1].second);  // room enough: one row
+  EXPECT_DOUBLE_EQ(short_at[1].second, short_at[2].second);
+}
+
 TEST(SvgPlot, MismatchedSeriesIsRejected) {
   Plot plot;
   EXPECT_THROW(plot.add_line("bad", {1, 2, 3}, {1, 2}), std::invalid_argument);
