@@ -228,10 +228,12 @@ BaResult solve_local_ba(const PinholeCamera& cam, BaProblem& problem, const BaCo
   state.build(active);
   options.linear_solver_ordering = state.ordering();
   if (adaptive) {
-    if (cfg.alpha_start != AlphaStart::SolveFirst)
+    if (cfg.alpha_start != AlphaStart::SolveFirst) {
       refit_alpha(active);
-    else
-      result.alpha_per_iteration.push_back(alpha);  // AlphaStart::SolveFirst: barron_alpha, no fit yet
+    } else {  // barron_alpha, no fit yet; it stands as its own fit so that both lists stay parallel
+      result.alpha_per_iteration.push_back(alpha);
+      result.fitted_alpha_per_iteration.push_back(alpha);
+    }
     AlphaCheckpoints checkpoints(cfg.iterations, cfg.outer_iterations, [&] {
       const double before = alpha;
       refit_alpha(active);

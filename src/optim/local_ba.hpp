@@ -59,7 +59,8 @@ struct BaResult {
   std::vector<bool> outlier_observation;  // at the final state: behind the camera, or failing the chi2 gate
   std::vector<double> alpha_per_iteration;  // BarronAdaptive: the alpha of each solve (fitted before it, except
                                             // the first one with AlphaStart::SolveFirst)
-  std::vector<double> fitted_alpha_per_iteration;  // the same fits before KernelConfig::alpha_max capped them
+  std::vector<double> fitted_alpha_per_iteration;  // parallel to alpha_per_iteration: the fits before
+                                                   // KernelConfig::alpha_max capped them
   double final_alpha = 2;                   // alpha of the last solve (barron_alpha for BarronFixed, 2 otherwise)
   double seconds = 0;
   // 0.5 * sum of squared whitened residuals over the observations that are inliers at the end, at the initial

@@ -164,10 +164,11 @@ std::string render_static_ratio_table(const std::vector<RunRecord>& records, con
     std::vector<std::string> rows = paths;
     rows.push_back("");  // all paths
     for (const auto& path : rows) {
-      if (std::none_of(configs.begin(), configs.end(), [&](const auto& c) { return paired(sc, path, c).runs > 0; }))
-        continue;
+      std::vector<PairedMeans> cells;
+      for (const auto& c : configs) cells.push_back(paired(sc, path, c));
+      if (std::none_of(cells.begin(), cells.end(), [](const PairedMeans& p) { return p.runs > 0; })) continue;
       t << "| " << sc << " | " << (path.empty() ? "all" : path) << " |";
-      for (const auto& c : configs) t << ' ' << ratio_cell(paired(sc, path, c)) << " |";
+      for (const auto& cell : cells) t << ' ' << ratio_cell(cell) << " |";
       t << '\n';
     }
   }

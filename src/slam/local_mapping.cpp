@@ -343,10 +343,8 @@ void LocalMapper::local_ba(const KeyFramePtr& kf) {
   if (!res.alpha_per_iteration.empty()) {
     const std::size_t last = std::min<std::size_t>(res.alpha_per_iteration.size(),
                                                    static_cast<std::size_t>(cfg_.ba_outer_iterations)) - 1;
-    rec.final_alpha = rec.fitted_alpha = res.alpha_per_iteration[last];
-    // AlphaStart::SolveFirst: the first solve had no fit, so the fitted list is one shorter.
-    const std::size_t offset = res.alpha_per_iteration.size() - res.fitted_alpha_per_iteration.size();
-    if (last >= offset) rec.fitted_alpha = res.fitted_alpha_per_iteration[last - offset];
+    rec.final_alpha = res.alpha_per_iteration[last];
+    rec.fitted_alpha = res.fitted_alpha_per_iteration[last];
   }
   rec.refine_alpha = res.final_alpha;
   rec.ms = ms_since(t0);

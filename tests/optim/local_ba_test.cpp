@@ -193,6 +193,9 @@ TEST(LocalBa, SolveFirstStartsFromTheConfiguredAlpha) {
   const BaResult r = solve_local_ba(cam, solved, cfg);
   ASSERT_EQ(r.alpha_per_iteration.size(), static_cast<std::size_t>(cfg.outer_iterations + 1));
   EXPECT_EQ(r.alpha_per_iteration[0], 0.5);  // no fit before the first solve
+  // The fits stay parallel to the applied alphas (local mapping indexes both with one index).
+  ASSERT_EQ(r.fitted_alpha_per_iteration.size(), r.alpha_per_iteration.size());
+  EXPECT_EQ(r.fitted_alpha_per_iteration[0], 0.5);
   EXPECT_LT(r.alpha_per_iteration[1], 1.0);   // fitted on the solved state: the wrong matches pull it down
   EXPECT_LT(mean_translation_error(solved, s.truth), 0.2 * mean_translation_error(s.initial, s.truth));
 }
