@@ -20,6 +20,17 @@ fs::path write_settings(const std::string& name, const std::string& body) {
   return p;
 }
 
+// The message of the ConfigError slam_config_from throws on `s`; a test failure (and "") when it throws none.
+std::string config_error_of(const Settings& s) {
+  try {
+    slam_config_from(s);
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "expected ConfigError";
+  return {};
+}
+
 // The paper's kernels, with a redescending shape in tracking (the paper's alpha 1 is a setting away).
 TEST(SlamConfig, DefaultsAreBarronKernels) {
   const SlamConfig c = slam_config_from(load_settings(write_settings("cfg_default.yaml", "")));
@@ -43,16 +54,11 @@ TEST(SlamConfig, ReadsKernelChoicesPerStage) {
 }
 
 TEST(SlamConfig, UnknownKernelNamesFileAndKey) {
-  const fs::path p = write_settings("cfg_bad_kernel.yaml", "mapping: {kernel: tukey}\n");
-  try {
-    slam_config_from(load_settings(p));
-    FAIL() << "expected ConfigError";
-  } catch (const ConfigError& e) {
-    const std::string msg = e.what();
-    EXPECT_NE(msg.find("cfg_bad_kernel.yaml"), std::string::npos) << msg;
-    EXPECT_NE(msg.find("mapping.kernel"), std::string::npos) << msg;
-    EXPECT_NE(msg.find("tukey"), std::string::npos) << msg;
-  }
+  const std::string msg =
+      config_error_of(load_settings(write_settings("cfg_bad_kernel.yaml", "mapping: {kernel: tukey}\n")));
+  EXPECT_NE(msg.find("cfg_bad_kernel.yaml"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("mapping.kernel"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("tukey"), std::string::npos) << msg;
 }
 
 TEST(SlamConfig, DisparityWeightIsReadAndChecked) {
@@ -61,13 +67,9 @@ TEST(SlamConfig, DisparityWeightIsReadAndChecked) {
   s.root["depth"]["disparity_weight"] = 0.0;  // ORB-SLAM3's residual
   EXPECT_DOUBLE_EQ(slam_config_from(s).tracking.disparity_weight, 0.0);
   s.root["depth"]["disparity_weight"] = -2.0;
-  try {
-    slam_config_from(s);
-    FAIL() << "expected ConfigError";
-  } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("depth.disparity_weight"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("cfg_dw.yaml"), std::string::npos) << e.what();
-  }
+  const std::string msg = config_error_of(s);
+  EXPECT_NE(msg.find("depth.disparity_weight"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("cfg_dw.yaml"), std::string::npos) << msg;
 }
 
 TEST(SlamConfig, LoopOwnPoseShareIsReadAndChecked) {
@@ -76,13 +78,9 @@ TEST(SlamConfig, LoopOwnPoseShareIsReadAndChecked) {
   s.root["loop"]["max_own_pose_share"] = 0.0;  // no check
   EXPECT_DOUBLE_EQ(slam_config_from(s).loop.max_own_pose_share, 0.0);
   s.root["loop"]["max_own_pose_share"] = -0.5;
-  try {
-    slam_config_from(s);
-    FAIL() << "expected ConfigError";
-  } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("loop.max_own_pose_share"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("cfg_own.yaml"), std::string::npos) << e.what();
-  }
+  const std::string msg = config_error_of(s);
+  EXPECT_NE(msg.find("loop.max_own_pose_share"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("cfg_own.yaml"), std::string::npos) << msg;
 }
 
 TEST(SlamConfig, AlphaMaxIsReadAndChecked) {
@@ -92,12 +90,8 @@ TEST(SlamConfig, AlphaMaxIsReadAndChecked) {
   s.root["mapping"]["alpha_max"] = 0.5;
   EXPECT_DOUBLE_EQ(slam_config_from(s).mapping.kernel.alpha_max, 0.5);
   s.root["mapping"]["alpha_max"] = 3.0;  // above the grid
-  try {
-    slam_config_from(s);
-    FAIL() << "expected ConfigError";
-  } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("mapping.alpha_max"), std::string::npos) << e.what();
-  }
+  const std::string msg = config_error_of(s);
+  EXPECT_NE(msg.find("mapping.alpha_max"), std::string::npos) << msg;
 }
 
 TEST(SlamConfig, DepthRegistrationIsAutoOrOff) {
@@ -106,12 +100,8 @@ TEST(SlamConfig, DepthRegistrationIsAutoOrOff) {
   s.root["depth"]["registration"] = "off";
   EXPECT_FALSE(slam_config_from(s).tracking.estimate_registration);
   s.root["depth"]["registration"] = "yes";
-  try {
-    slam_config_from(s);
-    FAIL() << "expected ConfigError";
-  } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("depth.registration"), std::string::npos) << e.what();
-  }
+  const std::string msg = config_error_of(s);
+  EXPECT_NE(msg.find("depth.registration"), std::string::npos) << msg;
 }
 
 TEST(SlamConfig, RejectsNonPositiveTau) {
