@@ -9,26 +9,6 @@
 
 namespace varslam::cli {
 
-void apply_overrides(Settings& settings, const std::vector<std::string>& overrides) {
-  if (overrides.empty()) return;
-  // Built-in defaults have no document yet: start from theirs, so camera/depth/ORB overrides apply too.
-  if (settings.source.empty()) settings.root = YAML::Load(settings_yaml(settings));
-  for (const std::string& o : overrides) {
-    const auto eq = o.find('=');
-    const auto dot = o.find('.');
-    if (eq == std::string::npos || dot == std::string::npos || dot > eq || dot == 0 || eq == dot + 1)
-      throw ConfigError(fmt::format("--set '{}': expected section.key=value (e.g. mapping.kernel=barron-adaptive)", o));
-    const std::string section = o.substr(0, dot), key = o.substr(dot + 1, eq - dot - 1), value = o.substr(eq + 1);
-    if (!settings.root || !settings.root.IsMap()) settings.root = YAML::Node(YAML::NodeType::Map);
-    YAML::Node sec = settings.root[section];
-    if (sec && !sec.IsMap())
-      throw ConfigError(fmt::format("--set '{}': settings key '{}' is not a section", o, section));
-    settings.root[section][key] = YAML::Load(value);
-  }
-  // Camera, depth and ORB fields were read when the document was loaded: read them again from the edited one.
-  settings = settings_from_yaml(settings.root, settings.source);
-}
-
 void write_report_for_run(const std::filesystem::path& run_dir, const std::filesystem::path& sequence_dir) {
   try {
     report::write_run_report(run_dir, sequence_dir, run_dir / "report.html");

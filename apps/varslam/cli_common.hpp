@@ -4,13 +4,10 @@
 #include <vector>
 
 #include "io/settings.hpp"
+#include "io/settings_registry.hpp"
 #include "slam/runner.hpp"
 
 namespace varslam::cli {
-
-/// Applies "section.key=value" overrides to the free-form stage sections of the settings (tracking, mapping,
-/// semantic, features, ...). Throws ConfigError on a malformed override.
-void apply_overrides(Settings& settings, const std::vector<std::string>& overrides);
 
 /// Writes <run>/report.html (plots of the trajectory, error, alpha per keyframe, timings); a failure is a warning.
 void write_report_for_run(const std::filesystem::path& run_dir, const std::filesystem::path& sequence_dir);

@@ -51,7 +51,7 @@ void add_demo_command(CLI::App& app) {
                                           "semantic.boxes_file=" + (data / "boxes.txt").string(),
                                           "tracking.kernel=barron-fixed", "mapping.kernel=barron-adaptive"};
     overrides.insert(overrides.end(), o->overrides.begin(), o->overrides.end());
-    apply_overrides(settings, overrides);
+    apply_setting_overrides(settings, overrides);
     const slam::SlamConfig cfg = slam::slam_config_from(settings);
     auto dataset = open_dataset(data, settings);
     slam::RunOptions ro;

@@ -34,7 +34,7 @@ void add_run_command(CLI::App& app) {
     std::optional<std::filesystem::path> sfile;
     if (!o->settings.empty()) sfile = o->settings;
     Settings settings = settings_for_dataset(o->dataset, sfile);
-    apply_overrides(settings, o->overrides);
+    apply_setting_overrides(settings, o->overrides);
     const slam::SlamConfig cfg = slam::slam_config_from(settings);
     auto dataset = open_dataset(o->dataset, settings);
     slam::RunOptions ro;

@@ -1,4 +1,5 @@
 // varslam: RGB-D visual SLAM for dynamic scenes. One CLI, one subcommand per job.
+#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include <exception>
@@ -7,6 +8,8 @@
 #include "core/error.hpp"
 
 int main(int argc, char** argv) {
+  // Logs and errors go to stderr; stdout carries what a command prints (summaries, `settings`, `eval`).
+  spdlog::set_default_logger(spdlog::stderr_color_mt("varslam"));
   CLI::App app{"varslam: RGB-D visual SLAM that stays accurate where things move"};
   app.require_subcommand(1);
   // Subcommands run inside parse(), so the log level is set as soon as the flag is parsed.
@@ -17,6 +20,7 @@ int main(int argc, char** argv) {
   varslam::cli::add_synth_command(app);
   varslam::cli::add_bench_command(app);
   varslam::cli::add_report_command(app);
+  varslam::cli::add_settings_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -6,14 +6,16 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
+#include "core/setting_keys.hpp"
+
 namespace varslam {
 
 struct OrbParams {
-  int n_features = 1000;      // total keypoint budget over all levels
-  double scale_factor = 1.2;  // scale ratio between consecutive pyramid levels
-  int n_levels = 8;
-  int ini_th_fast = 20;  // FAST threshold tried first in every grid cell
-  int min_th_fast = 7;   // fallback threshold for cells where the first one finds nothing
+  int n_features = setting_keys::int_default("orb.n_features");  // total keypoint budget over all levels
+  double scale_factor = setting_keys::real_default("orb.scale_factor");  // between consecutive pyramid levels
+  int n_levels = setting_keys::int_default("orb.n_levels");
+  int ini_th_fast = setting_keys::int_default("orb.ini_th_fast");  // FAST threshold tried first in every cell
+  int min_th_fast = setting_keys::int_default("orb.min_th_fast");  // where the first one finds nothing
 };
 
 enum class ExtractorKind { Ours, OpenCV };

@@ -9,30 +9,31 @@
 #include <vector>
 
 #include "core/detection.hpp"
+#include "core/setting_keys.hpp"
 
 namespace varslam::semantic {
 
 struct DetectorConfig {
-  std::string source = "none";  // yolo | boxes | hog | none
+  std::string source{setting_keys::text_default("semantic.detector")};  // yolo | boxes | hog | none
   // yolo: Darknet cfg + weights, or an .onnx file as weights (cfg unused). Empty cfg and weights mean the preset
   // `model` (<model>.cfg + <model>.weights). A relative path that does not exist as given is looked up in
   // model_dir and the default model directories (see model_search_dirs). Empty names_file: <weights stem>.names,
   // else the preset's names (body.names for the body model), else coco.names.
-  std::string model = "yolo-fastest-1.1-xl";  // or "yolo-fastest-1.1_body"
+  std::string model{setting_keys::text_default("semantic.model")};  // or "yolo-fastest-1.1_body"
   std::filesystem::path model_dir;
   std::filesystem::path model_cfg, model_weights, names_file;
-  int input_size = 320;
-  float conf_threshold = 0.3f;
-  float nms_threshold = 0.45f;
-  std::vector<std::string> classes = {"person"};  // labels kept (after aliasing)
+  int input_size = setting_keys::int_default("semantic.input_size");
+  float conf_threshold = static_cast<float>(setting_keys::real_default("semantic.conf_threshold"));
+  float nms_threshold = static_cast<float>(setting_keys::real_default("semantic.nms_threshold"));
+  std::vector<std::string> classes = setting_keys::list_default("semantic.classes");  // kept (after aliasing)
   // Model labels renamed before the class filter; the 1-class Yolo-Fastest body model says "body".
-  std::map<std::string, std::string> label_aliases = {{"body", "person"}};
+  std::map<std::string, std::string> label_aliases = setting_keys::map_default("semantic.label_aliases");
   // yolo: OpenCV worker threads, set when the detector is built. cv::setNumThreads is process wide (TBB
   // backend), so this also applies to the tracker's OpenCV calls; 1 leaves the other core to the tracker, which
   // on a 2-core machine costs the detector little (see bench/semantic_bench.cpp). 0 leaves OpenCV's setting.
-  int num_threads = 1;
+  int num_threads = setting_keys::int_default("semantic.num_threads");
   std::filesystem::path boxes_file;  // boxes: per-frame file (src/io/boxes_io.hpp format)
-  double boxes_max_dt = 0.02;        // boxes: largest timestamp gap to still use a frame's boxes
+  double boxes_max_dt = setting_keys::real_default("semantic.boxes_max_dt");  // boxes: largest timestamp gap
 };
 
 class Detector {

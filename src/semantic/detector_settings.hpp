@@ -29,9 +29,9 @@ namespace varslam::semantic {
 struct SemanticSettings {
   DetectorConfig detector;
   FilterConfig filter;
-  bool asynchronous = true;
-  bool propagate_boxes = true;
-  bool mask_extraction = true;
+  bool asynchronous = setting_keys::bool_default("semantic.asynchronous");
+  bool propagate_boxes = setting_keys::bool_default("semantic.propagate_boxes");
+  bool mask_extraction = setting_keys::bool_default("semantic.mask_extraction");
 };
 
 /// Defaults for missing keys; a key with a wrong type or value is a ConfigError naming the settings file and key.

@@ -7,26 +7,27 @@
 #include <vector>
 
 #include "core/detection.hpp"
+#include "core/setting_keys.hpp"
 
 namespace varslam::semantic {
 
 struct FilterConfig {
-  float box_enlarge = 0.1f;    // fraction of width/height added on each side of a box
-  float depth_band_m = 0.5f;   // keypoints within +-band of the person depth are dynamic
-  float min_depth_m = 0.1f;    // depths outside [min, max] count as invalid
-  float max_depth_m = 20.0f;
-  float bin_m = 0.1f;          // histogram bin width for the person-depth mode
+  float box_enlarge = static_cast<float>(setting_keys::real_default("semantic.box_enlarge"));    // fraction of width/height added on each side of a box
+  float depth_band_m = static_cast<float>(setting_keys::real_default("semantic.depth_band_m"));   // keypoints within +-band of the person depth are dynamic
+  float min_depth_m = static_cast<float>(setting_keys::real_default("semantic.min_depth_m"));    // depths outside [min, max] count as invalid
+  float max_depth_m = static_cast<float>(setting_keys::real_default("semantic.max_depth_m"));
+  float bin_m = static_cast<float>(setting_keys::real_default("semantic.bin_m"));          // histogram bin width for the person-depth mode
   // A near histogram peak is "strong" when it holds at least this fraction of the box's valid depths.
-  float peak_fraction = 0.15f;
-  int sample_step = 2;         // depth samples every n-th pixel inside a box (cost vs. accuracy)
+  float peak_fraction = static_cast<float>(setting_keys::real_default("semantic.peak_fraction"));
+  int sample_step = setting_keys::int_default("semantic.sample_step");         // depth samples every n-th pixel inside a box (cost vs. accuracy)
   // Background keypoints closer than this (pixels at pyramid level 0, scaled with the keypoint's size) to a pixel
   // at the person's depth are dropped too: a corner on the silhouette moves with the person. 0 = off (default:
   // on the synthetic walking sequences 5 px removed 95 % of such keypoints but did not lower the ATE).
-  float silhouette_margin_px = 0.0f;
+  float silhouette_margin_px = static_cast<float>(setting_keys::real_default("semantic.silhouette_margin_px"));
   // Overlapping boxes: a second person depth from the part of the box no other box covers, when that part holds at
   // least this share of the box's depth samples (the nearer person must not capture the farther one's estimate).
   // 1 = off (default, for the same reason as the margin; 0.2 removed most leaks between overlapping people).
-  float min_exclusive_share = 1.0f;
+  float min_exclusive_share = static_cast<float>(setting_keys::real_default("semantic.min_exclusive_share"));
 };
 
 struct FilterStats {

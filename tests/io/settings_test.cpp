@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "core/error.hpp"
+#include "io/settings_registry.hpp"
 #include "io/temp_dir.hpp"
 
 namespace varslam {
@@ -74,7 +75,7 @@ TEST(Settings, OurLayoutRoundTripKeepsEveryFieldAndStageSections) {
   s.depth_factor = 1000;
   s.th_depth = 35.5;
   s.orb = {1500, 1.25, 6, 18, 5};
-  s.root = YAML::Load("tracking: {kernel: barron, iterations: 7, robust: true}\nmapping: {window: 12.5}\n");
+  s.root = YAML::Load("tracking: {kernel: huber, vo_points: 7, chi2_gates: false}\nmapping: {tau: 12.5}\n");
   const auto file = dir / "settings.yaml";
   save_settings(s, file);
 
@@ -100,10 +101,10 @@ TEST(Settings, OurLayoutRoundTripKeepsEveryFieldAndStageSections) {
   EXPECT_EQ(r.orb.n_levels, 6);
   EXPECT_EQ(r.orb.ini_th_fast, 18);
   EXPECT_EQ(r.orb.min_th_fast, 5);
-  EXPECT_EQ(setting_or<std::string>(r, "tracking.kernel", "l2"), "barron");
-  EXPECT_EQ(setting_or<int>(r, "tracking.iterations", 0), 7);
-  EXPECT_TRUE(setting_or<bool>(r, "tracking.robust", false));
-  EXPECT_DOUBLE_EQ(setting_or<double>(r, "mapping.window", 0.0), 12.5);
+  EXPECT_EQ(setting<std::string>(r, "tracking.kernel"), "huber");
+  EXPECT_EQ(setting<int>(r, "tracking.vo_points"), 7);
+  EXPECT_FALSE(setting<bool>(r, "tracking.chi2_gates"));
+  EXPECT_DOUBLE_EQ(setting<double>(r, "mapping.tau"), 12.5);
 }
 
 TEST(Settings, WritesBaselineInMetres) {
@@ -137,9 +138,9 @@ TEST(Settings, ReadsThe7ScenesOrbSlam3File) {
   EXPECT_EQ(s.orb.n_levels, 8);
   EXPECT_EQ(s.orb.ini_th_fast, 20);
   EXPECT_EQ(s.orb.min_th_fast, 7);
-  // Flat ORB-SLAM keys (one key with dots in its name) are reachable too.
-  EXPECT_DOUBLE_EQ(setting_or<double>(s, "Viewer.PointSize", 0.0), 2.0);
-  EXPECT_EQ(setting_or<std::string>(s, "Camera.type", ""), "PinHole");
+  // Flat ORB-SLAM keys (one key with dots in its name) are read under our names.
+  EXPECT_DOUBLE_EQ(setting<double>(s, "camera.fx"), 585.0);
+  EXPECT_EQ(setting<int>(s, "orb.n_levels"), 8);
 }
 
 TEST(Settings, EditedDocumentIsReadAgainIncludingCameraDepthAndOrbFields) {
@@ -217,8 +218,7 @@ Viewer.KeyFrameSize: 0.05
   EXPECT_DOUBLE_EQ(s.depth_factor, 5000.0);
   EXPECT_DOUBLE_EQ(s.th_depth, 40.0);
   EXPECT_EQ(s.orb.n_features, 1200);
-  EXPECT_EQ(setting_or<int>(s, "Tbc.rows", 0), 4);
-  EXPECT_TRUE(setting_or<bool>(s, "Camera.RGB", false));  // ORB-SLAM writes flags as 0/1
+  EXPECT_EQ(setting<int>(s, "orb.n_features"), 1200);
 }
 
 TEST(Settings, WrongTypeNamesFileLineAndKey) {
@@ -235,7 +235,7 @@ TEST(Settings, OrbSlamKeyErrorsUseTheOrbSlamKeyName) {
   const auto file = dir.write("orb.yaml", "%YAML:1.0\nCamera1.fx: 500\nCamera1.fy: -3\nCamera1.cx: 320\n"
                                           "Camera1.cy: 240\nCamera.width: 640\nCamera.height: 480\n");
   const std::string msg = config_error([&] { load_settings(file); });
-  EXPECT_THAT(msg, AllOf(HasSubstr(file.string() + ":3:"), HasSubstr("Camera1.fy"), HasSubstr("> 0")));
+  EXPECT_THAT(msg, AllOf(HasSubstr(file.string() + ":3:"), HasSubstr("Camera1.fy"), HasSubstr("(0, 100000]")));
 }
 
 struct BadValue {
@@ -279,24 +279,28 @@ TEST(Settings, MissingFileAndInvalidYamlAreConfigErrors) {
   EXPECT_THAT(config_error([&] { load_settings(list); }), HasSubstr("list.yaml"));
 }
 
-TEST(Settings, SettingOrFallsBackAndRejectsWrongTypes) {
+TEST(Settings, TypedReadsFallBackToTheRegistryAndRejectWrongTypes) {
   TempDir dir;
   std::string text = kOurs;
-  text += "tracking:\n  kernel: barron\n  iterations: 3.5\n  robust: maybe\n  empty:\n";
+  text += "tracking:\n  kernel: huber\n  vo_points: 3.5\n  chi2_gates: maybe\n  tau:\n";
   const auto file = dir.write("s.yaml", text);
-  const Settings s = load_settings(file);
-  EXPECT_EQ(setting_or<int>(s, "tracking.missing", 42), 42);
-  EXPECT_EQ(setting_or<int>(s, "nosection.key", 5), 5);
-  EXPECT_EQ(setting_or<int>(s, "tracking.kernel.deeper", 6), 6);
-  EXPECT_EQ(setting_or<double>(s, "tracking.empty", 1.5), 1.5);  // null counts as absent
-  EXPECT_DOUBLE_EQ(setting_or<double>(s, "tracking.iterations", 0.0), 3.5);
-  EXPECT_THAT(config_error([&] { setting_or<int>(s, "tracking.iterations", 0); }),
-              AllOf(HasSubstr(file.string()), HasSubstr("tracking.iterations"), HasSubstr("integer")));
-  EXPECT_THAT(config_error([&] { setting_or<bool>(s, "tracking.robust", false); }),
-              AllOf(HasSubstr(file.string()), HasSubstr("tracking.robust")));
-  EXPECT_THAT(config_error([&] { setting_or<std::string>(s, "tracking", ""); }), HasSubstr("tracking"));
-  // Defaults have no document: every key falls back.
-  EXPECT_EQ(setting_or<std::string>(default_settings(), "tracking.kernel", "l2"), "l2");
+  YAML::Node doc = YAML::Load(text);
+  // A whole-document check names the first bad key with its line.
+  EXPECT_THAT(config_error([&] { load_settings(file); }),
+              AllOf(HasSubstr(file.string() + ":14:"), HasSubstr("tracking.vo_points"), HasSubstr("integer")));
+  Settings s = default_settings();
+  s.root = doc;
+  s.source = file;
+  EXPECT_EQ(setting<int>(s, "tracking.close_keyframe_gap"), 5);  // absent: the registry's default
+  EXPECT_DOUBLE_EQ(setting<double>(s, "tracking.tau"), 10.0);    // null counts as absent
+  EXPECT_THAT(config_error([&] { setting<int>(s, "tracking.vo_points"); }),
+              AllOf(HasSubstr(file.string()), HasSubstr("tracking.vo_points"), HasSubstr("integer")));
+  EXPECT_THAT(config_error([&] { setting<bool>(s, "tracking.chi2_gates"); }),
+              AllOf(HasSubstr(file.string()), HasSubstr("tracking.chi2_gates"), HasSubstr("true or false")));
+  EXPECT_EQ(setting<std::string>(default_settings(), "tracking.kernel"), "barron-fixed");
+  // Reading a key the registry does not declare is a programming error, not a silent default.
+  EXPECT_THROW(setting<int>(s, "tracking.nosuch"), std::logic_error);
+  EXPECT_THROW(setting<int>(s, "tracking.kernel"), std::logic_error);  // declared as a choice
 }
 
 }  // namespace

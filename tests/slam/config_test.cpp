@@ -23,7 +23,7 @@ fs::path write_settings(const std::string& name, const std::string& body) {
 // The message of the ConfigError slam_config_from throws on `s`; a test failure (and "") when it throws none.
 std::string config_error_of(const Settings& s) {
   try {
-    slam_config_from(s);
+    slam_config_from(settings_from_yaml(s.root, s.source));
   } catch (const ConfigError& e) {
     return e.what();
   }
@@ -54,8 +54,9 @@ TEST(SlamConfig, ReadsKernelChoicesPerStage) {
 }
 
 TEST(SlamConfig, UnknownKernelNamesFileAndKey) {
-  const std::string msg =
-      config_error_of(load_settings(write_settings("cfg_bad_kernel.yaml", "mapping: {kernel: tukey}\n")));
+  Settings s = load_settings(write_settings("cfg_bad_kernel.yaml", ""));
+  s.root["mapping"]["kernel"] = "tukey";
+  const std::string msg = config_error_of(s);
   EXPECT_NE(msg.find("cfg_bad_kernel.yaml"), std::string::npos) << msg;
   EXPECT_NE(msg.find("mapping.kernel"), std::string::npos) << msg;
   EXPECT_NE(msg.find("tukey"), std::string::npos) << msg;
@@ -106,6 +107,32 @@ TEST(SlamConfig, DepthRegistrationIsAutoOrOff) {
 
 TEST(SlamConfig, RejectsNonPositiveTau) {
   EXPECT_THROW(slam_config_from(load_settings(write_settings("cfg_tau.yaml", "mapping: {tau: -1}\n"))), ConfigError);
+}
+
+// The structs' own defaults are the registry's: a default-constructed config equals one read from no settings.
+TEST(SlamConfig, StructDefaultsAreTheRegistrysDefaults) {
+  const SlamConfig built;
+  const SlamConfig read = slam_config_from(default_settings());
+  const auto same_kernel = [](const optim::KernelConfig& a, const optim::KernelConfig& b) {
+    return a.type == b.type && a.barron_alpha == b.barron_alpha && a.barron_c == b.barron_c && a.tau == b.tau &&
+           a.alpha_max == b.alpha_max && a.fit == b.fit && a.chi2_gates == b.chi2_gates;
+  };
+  EXPECT_TRUE(same_kernel(built.tracking.kernel, read.tracking.kernel));
+  EXPECT_TRUE(same_kernel(built.mapping.kernel, read.mapping.kernel));
+  EXPECT_EQ(built.tracking.kernel.type, optim::KernelType::BarronFixed);
+  EXPECT_DOUBLE_EQ(built.mapping.kernel.alpha_max, 1.0);
+  EXPECT_EQ(built.tracking.close_keyframe_gap, read.tracking.close_keyframe_gap);
+  EXPECT_EQ(built.tracking.established_age, read.tracking.established_age);
+  EXPECT_EQ(built.tracking.min_inliers_local_map, read.tracking.min_inliers_local_map);
+  EXPECT_DOUBLE_EQ(built.tracking.disparity_weight, read.tracking.disparity_weight);
+  EXPECT_EQ(built.tracking.estimate_registration, read.tracking.estimate_registration);
+  EXPECT_EQ(built.mapping.max_ba_keyframes, read.mapping.max_ba_keyframes);
+  EXPECT_DOUBLE_EQ(built.mapping.keyframe_redundancy, read.mapping.keyframe_redundancy);
+  EXPECT_EQ(built.loop.min_inliers, read.loop.min_inliers);
+  EXPECT_DOUBLE_EQ(built.loop.max_own_pose_share, read.loop.max_own_pose_share);
+  EXPECT_EQ(built.relocalization.candidates, read.relocalization.candidates);
+  EXPECT_EQ(built.orb.n_features, read.orb.n_features);
+  EXPECT_EQ(built.extractor, read.extractor);
 }
 
 TEST(SlamConfig, ShippedCameraFilesLoad) {

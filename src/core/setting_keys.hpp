@@ -1,0 +1,270 @@
+#pragma once
+// The settings registry: every key varslam reads, declared once with its type, default, valid range or choices
+// and meaning. The YAML reader, `--set`, the ORB-SLAM3 key mapping, `varslam settings`, docs/settings.md and the
+// config structs' defaults all come from this table. Pure data (no YAML), so every module can take its defaults
+// from here at compile time: `int gap = setting_keys::int_default("tracking.close_keyframe_gap");` fails to
+// compile when the key is not declared.
+#include <limits>
+#include <map>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace varslam::setting_keys {
+
+enum class KeyType {
+  Int,       // an integer in [lo, hi]
+  Real,      // a finite number in [lo, hi] (or open at an end)
+  Bool,      // true / false (ORB-SLAM files: 0 / 1)
+  Choice,    // one of `choices`
+  Text,      // free text
+  Path,      // a file or folder; relative to the settings file when that makes it exist
+  TextList,  // a YAML list of strings (default: comma separated)
+  TextMap,   // a YAML map of string to string (default: "from:to,from:to")
+};
+
+struct KeySpec {
+  std::string_view name;  // section.key
+  KeyType type = KeyType::Real;
+  double number = 0;        // default of Int / Real / Bool (0 or 1)
+  std::string_view text{};  // default of Choice / Text / Path / TextList / TextMap
+  double lo = -std::numeric_limits<double>::infinity();
+  double hi = std::numeric_limits<double>::infinity();
+  bool lo_open = false, hi_open = false;  // the range excludes that end
+  std::string_view choices{};             // Choice: "a|b|c"
+  std::string_view meaning{};
+  std::string_view aliases{};   // other spellings read from files (ORB-SLAM3 / ORB-SLAM2 layouts), '|' separated
+  bool has_default = true;      // false: absent unless given (its meaning says what then)
+};
+
+namespace detail {
+inline constexpr double kInf = std::numeric_limits<double>::infinity();
+
+constexpr KeySpec integer(std::string_view name, int def, double lo, double hi, std::string_view meaning,
+                          std::string_view aliases = {}) {
+  return {name, KeyType::Int, static_cast<double>(def), {}, lo, hi, false, false, {}, meaning, aliases, true};
+}
+// A real in [lo, hi]; `open` = "(" / ")" / "()" makes that end exclusive.
+constexpr KeySpec real(std::string_view name, double def, double lo, double hi, std::string_view meaning,
+                       std::string_view aliases = {}, std::string_view open = {}) {
+  const bool lo_open = open.find('(') != std::string_view::npos, hi_open = open.find(')') != std::string_view::npos;
+  return {name, KeyType::Real, def, {}, lo, hi, lo_open, hi_open, {}, meaning, aliases, true};
+}
+constexpr KeySpec positive(std::string_view name, double def, double hi, std::string_view meaning,
+                           std::string_view aliases = {}) {
+  return real(name, def, 0.0, hi, meaning, aliases, "(");
+}
+constexpr KeySpec optional_real(std::string_view name, double lo, double hi, std::string_view meaning,
+                                std::string_view open = {}, std::string_view aliases = {}) {
+  KeySpec k = real(name, 0.0, lo, hi, meaning, aliases, open);
+  k.has_default = false;
+  return k;
+}
+constexpr KeySpec flag(std::string_view name, bool def, std::string_view meaning) {
+  return {name, KeyType::Bool, def ? 1.0 : 0.0, {}, 0, 1, false, false, {}, meaning, {}, true};
+}
+constexpr KeySpec choice(std::string_view name, std::string_view def, std::string_view choices,
+                         std::string_view meaning) {
+  return {name, KeyType::Choice, 0, def, -kInf, kInf, false, false, choices, meaning, {}, true};
+}
+constexpr KeySpec textual(KeyType type, std::string_view name, std::string_view def, std::string_view meaning) {
+  return {name, type, 0, def, -kInf, kInf, false, false, {}, meaning, {}, true};
+}
+}  // namespace detail
+
+// clang-format off
+inline constexpr KeySpec kKeys[] = {
+    // camera: the colour camera (pinhole + Brown-Conrady distortion). Built-in default: TUM fr1 intrinsics without
+    // distortion, what the synthetic generator renders.
+    detail::positive("camera.fx", 517.3, 1e5, "focal length x (pixels); required in a settings file", "Camera1.fx|Camera.fx"),
+    detail::positive("camera.fy", 516.5, 1e5, "focal length y (pixels); required in a settings file", "Camera1.fy|Camera.fy"),
+    detail::real("camera.cx", 318.6, -1e5, 1e5, "principal point x (pixels); required in a settings file", "Camera1.cx|Camera.cx"),
+    detail::real("camera.cy", 255.3, -1e5, 1e5, "principal point y (pixels); required in a settings file", "Camera1.cy|Camera.cy"),
+    detail::real("camera.k1", 0.0, -1e3, 1e3, "radial distortion k1", "Camera1.k1|Camera.k1"),
+    detail::real("camera.k2", 0.0, -1e3, 1e3, "radial distortion k2", "Camera1.k2|Camera.k2"),
+    detail::real("camera.p1", 0.0, -1e3, 1e3, "tangential distortion p1", "Camera1.p1|Camera.p1"),
+    detail::real("camera.p2", 0.0, -1e3, 1e3, "tangential distortion p2", "Camera1.p2|Camera.p2"),
+    detail::real("camera.k3", 0.0, -1e3, 1e3, "radial distortion k3", "Camera1.k3|Camera.k3"),
+    detail::integer("camera.width", 640, 1, 100000, "image width (pixels)", "Camera.width"),
+    detail::integer("camera.height", 480, 1, 100000, "image height (pixels)", "Camera.height"),
+    detail::positive("camera.fps", 30.0, 1000, "frame rate (Hz): pacing and the motion model's time step", "Camera.fps"),
+    detail::optional_real("camera.baseline", 0.0, 10.0, "virtual stereo baseline (m) of the depth residual; when given, bf = fx * baseline", "(", "Stereo.b"),
+    detail::positive("camera.bf", 40.0, 1e5, "fx times the virtual stereo baseline (pixels metres), used when camera.baseline is absent", "Camera.bf"),
+
+    // depth: how raw depth becomes metres and how far it is trusted.
+    detail::positive("depth.factor", 5000.0, 1e6, "raw depth units per metre (TUM/Bonn 5000, OpenLORIS/7-Scenes 1000)", "RGBD.DepthMapFactor|DepthMapFactor"),
+    detail::positive("depth.th_depth", 40.0, 1e4, "close/far threshold in baselines (ORB-SLAM's ThDepth): points nearer than th_depth * baseline are close", "Stereo.ThDepth|ThDepth"),
+    detail::real("depth.edge_ratio", 0.1, 0.0, 1.0, "keypoints on depth discontinuities keep no depth (colour and depth of real sensors are misregistered there); 0 = off"),
+    detail::real("depth.disparity_weight", 10.0, 0.0, 1e4, "depth term of pose optimisation and BA: disparity bf/z with sigma 1/weight pixels; 0 = ORB-SLAM3's virtual-stereo residual"),
+    detail::choice("depth.registration", "auto", "auto|off", "auto: check on 10 frames whether depth is registered to colour and warp it into the colour camera when it clearly is not"),
+    detail::optional_real("depth.camera_fx", 0.0, 1e5, "depth camera focal length x: when given, depth comes from this separate camera and is warped into the colour camera", "("),
+    detail::optional_real("depth.camera_fy", 0.0, 1e5, "depth camera focal length y (default: depth.camera_fx)", "("),
+    detail::optional_real("depth.camera_cx", -1e5, 1e5, "depth camera principal point x (default: camera.cx)"),
+    detail::optional_real("depth.camera_cy", -1e5, 1e5, "depth camera principal point y (default: camera.cy)"),
+    detail::real("depth.camera_tx", 0.0, -10.0, 10.0, "depth camera origin in the colour frame, x (m)"),
+    detail::real("depth.camera_ty", 0.0, -10.0, 10.0, "depth camera origin in the colour frame, y (m)"),
+    detail::real("depth.camera_tz", 0.0, -10.0, 10.0, "depth camera origin in the colour frame, z (m)"),
+
+    // orb: the feature extractor.
+    detail::integer("orb.n_features", 1000, 1, 100000, "ORB keypoints per frame", "ORBextractor.nFeatures"),
+    detail::real("orb.scale_factor", 1.2, 1.0, 4.0, "scale between pyramid levels", "ORBextractor.scaleFactor", "("),
+    detail::integer("orb.n_levels", 8, 1, 32, "pyramid levels", "ORBextractor.nLevels"),
+    detail::integer("orb.ini_th_fast", 20, 1, 255, "FAST threshold tried first in each grid cell", "ORBextractor.iniThFAST"),
+    detail::integer("orb.min_th_fast", 7, 1, 255, "FAST threshold where a cell finds nothing at ini_th_fast (at most ini_th_fast)", "ORBextractor.minThFAST"),
+    detail::choice("features.extractor", "ours", "ours|opencv", "ORB extractor: our own, or OpenCV's cv::ORB"),
+
+    // tracking: frame pose estimation and the keyframe decision.
+    detail::choice("tracking.kernel", "barron-fixed", "huber|barron-fixed|barron-adaptive|none", "robust kernel of frame pose optimisation (huber = ORB-SLAM3)"),
+    detail::real("tracking.barron_alpha", -2.0, -10.0, 2.0, "Barron shape of the fixed kernel: -2 redescends (a box flying past stops pulling); the paper uses 1"),
+    detail::positive("tracking.barron_c", 1.0, 1e3, "Barron scale on whitened residuals"),
+    detail::positive("tracking.tau", 10.0, 1e3, "truncation of the log-partition table (barron-adaptive)"),
+    detail::real("tracking.alpha_max", 2.0, -10.0, 2.0, "cap on the fitted alpha (barron-adaptive)"),
+    detail::choice("tracking.alpha_fit", "norm", "norm|component", "what the adaptive alpha is fitted on: residual norms or components"),
+    detail::flag("tracking.chi2_gates", true, "ORB-SLAM's chi-square outlier gates (5.991 / 7.815) on top of the kernel"),
+    detail::positive("tracking.motion_radius", 15.0, 1000, "search radius (pixels at level 0) when matching against the last frame"),
+    detail::integer("tracking.min_matches", 20, 3, 100000, "matches needed before a pose is optimised (motion model, reference keyframe)"),
+    detail::real("tracking.motion_inlier_ratio", 0.5, 0.0, 1.0, "a motion-model pose keeping fewer inliers than this share of its matches is cross-checked against the reference keyframe"),
+    detail::integer("tracking.established_found", 3, 0, 1000000, "frames a point must have been an inlier in to anchor the first pose round (0 = off)"),
+    detail::integer("tracking.established_age", 10, 0, 1000000, "frames since creation a point needs to anchor the first pose round (0 = off)"),
+    detail::integer("tracking.min_inliers", 30, 3, 100000, "inliers after local-map tracking for a frame to count as tracked"),
+    detail::integer("tracking.max_local_keyframes", 80, 1, 100000, "keyframes of the local map a frame is tracked against"),
+    detail::integer("tracking.lost_frames_before_reinit", 3, 1, 1000000, "failed recoveries before a new map segment starts"),
+    detail::integer("tracking.vo_points", 100, 0, 100000, "temporary depth points kept in the last frame (RGB-D visual odometry)"),
+    detail::integer("tracking.close_keyframe_gap", 5, 1, 1000000, "frames between keyframes triggered by untracked close points"),
+
+    // mapping: local mapping and Local BA.
+    detail::choice("mapping.kernel", "barron-adaptive", "huber|barron-fixed|barron-adaptive|none", "robust kernel of Local BA (paper: barron-adaptive; huber = ORB-SLAM3)"),
+    detail::real("mapping.barron_alpha", 1.0, -10.0, 2.0, "Barron shape (barron-fixed), and the starting alpha of barron-adaptive before any fit"),
+    detail::positive("mapping.barron_c", 1.0, 1e3, "Barron scale on whitened residuals"),
+    detail::positive("mapping.tau", 10.0, 1e3, "truncation of the log-partition table (barron-adaptive)"),
+    detail::real("mapping.alpha_max", 1.0, -10.0, 2.0, "cap on the fitted alpha: 1 = pseudo-Huber, 2 = the paper's uncapped fit"),
+    detail::choice("mapping.alpha_fit", "norm", "norm|component", "what the adaptive alpha is fitted on: residual norms (the paper) or components"),
+    detail::flag("mapping.chi2_gates", true, "ORB-SLAM's chi-square outlier gates on top of the kernel"),
+    detail::integer("mapping.ba_outer_iterations", 3, 1, 100, "alternations of alpha fit and solve per Local BA"),
+    detail::integer("mapping.ba_iterations", 5, 1, 1000, "solver iterations per alternation"),
+    detail::integer("mapping.ba_refine_iterations", 10, 0, 1000, "solver iterations of the refine solve on the gated inliers"),
+    detail::integer("mapping.triangulation_neighbours", 10, 1, 1000, "covisible keyframes searched for new points"),
+    detail::integer("mapping.max_ba_keyframes", 20, 2, 10000, "keyframes optimised per Local BA (the most covisible); the others observing stay fixed"),
+    detail::real("mapping.keyframe_redundancy", 0.9, 0.0, 1.0, "share of a keyframe's points seen by 3 other keyframes that makes it redundant", {}, "("),
+    detail::flag("mapping.cull_keyframes", true, "remove redundant keyframes"),
+
+    // loop: place recognition and loop correction.
+    detail::flag("loop.enabled", true, "look for and close loops"),
+    detail::integer("loop.min_keyframes", 10, 0, 1000000, "keyframes in the map before loops are sought"),
+    detail::integer("loop.min_keyframe_gap", 10, 1, 1000000, "a candidate is at least this many keyframe ids older than the query"),
+    detail::integer("loop.min_score", 30, 1, 256, "signature matches (of 256) for a place candidate"),
+    detail::integer("loop.candidates", 3, 1, 100, "best place candidates verified per keyframe"),
+    detail::integer("loop.min_ransac_inliers", 25, 3, 100000, "3-D/3-D RANSAC inliers against the candidate keyframe"),
+    detail::integer("loop.min_inliers", 80, 3, 100000, "pose inliers after guided matching against the candidate's neighbourhood"),
+    detail::integer("loop.keyframes_after_loop", 5, 0, 1000000, "keyframes skipped after a closure"),
+    detail::real("loop.max_own_pose_share", 0.2, 0.0, 10.0, "refuse a loop whose side, matched from the keyframe's own pose, gives this share of the loop pose's inliers (a mover matched to itself); 0 = off"),
+    detail::integer("loop.pose_graph_min_weight", 100, 1, 1000000, "covisibility weight for a pose-graph edge (besides the spanning tree)"),
+    detail::flag("loop.global_ba", true, "global BA after each closed loop"),
+    detail::integer("loop.global_ba_iterations", 10, 1, 1000, "iterations of that global BA"),
+    detail::flag("loop.final_global_ba", false, "one global BA when the run ends"),
+
+    // relocalization: recovery after tracking loss.
+    detail::flag("relocalization.enabled", true, "relocalize against the place database when tracking is lost"),
+    detail::integer("relocalization.min_score", 25, 1, 256, "signature matches (of 256) for a candidate keyframe"),
+    detail::integer("relocalization.candidates", 5, 1, 100, "candidates tried per lost frame"),
+    detail::integer("relocalization.min_inliers", 30, 3, 100000, "pose inliers against the candidate keyframe"),
+
+    // semantic: the person detector and the depth-aware keypoint filter.
+    detail::choice("semantic.detector", "none", "yolo|boxes|hog|none", "person detector: yolo (OpenCV dnn), boxes (a boxes file), hog, none (no person filter)"),
+    detail::textual(KeyType::Text, "semantic.model", "yolo-fastest-1.1-xl", "YOLO preset (yolo-fastest-1.1-xl, yolo-fastest-1.1_body), looked up in model_dir, $VARSLAM_MODELS, ./models, ../shared/models"),
+    detail::textual(KeyType::Path, "semantic.model_dir", "", "folder searched first for the model files"),
+    detail::textual(KeyType::Path, "semantic.model_cfg", "", "Darknet cfg (with model_weights; instead of a preset)"),
+    detail::textual(KeyType::Path, "semantic.model_weights", "", "Darknet weights or an ONNX file (instead of a preset)"),
+    detail::textual(KeyType::Path, "semantic.names_file", "", "class names, one per line (default: COCO's)"),
+    detail::integer("semantic.input_size", 320, 32, 4096, "network input size (a multiple of 32)"),
+    detail::real("semantic.conf_threshold", 0.3, 0.0, 1.0, "detection confidence threshold"),
+    detail::real("semantic.nms_threshold", 0.45, 0.0, 1.0, "non-maximum suppression overlap", {}, "("),
+    detail::textual(KeyType::TextList, "semantic.classes", "person", "labels kept (after aliasing)"),
+    detail::textual(KeyType::TextMap, "semantic.label_aliases", "body:person", "labels renamed before the class test"),
+    detail::integer("semantic.num_threads", 1, 0, 256, "OpenCV threads of the detector (0 = OpenCV's choice)"),
+    detail::textual(KeyType::Path, "semantic.boxes_file", "", "boxes file of detector: boxes (one line per box: timestamp label score x y w h)"),
+    detail::real("semantic.boxes_max_dt", 0.02, 0.0, 10.0, "largest timestamp gap (s) to still use a frame's boxes from the boxes file"),
+    detail::real("semantic.box_enlarge", 0.1, 0.0, 2.0, "fraction of width and height added on each side of a box", {}, ")"),
+    detail::positive("semantic.depth_band_m", 0.5, 10.0, "keypoints within this distance (m) of the person depth are dropped"),
+    detail::real("semantic.min_depth_m", 0.1, 0.0, 100.0, "depths below count as invalid"),
+    detail::positive("semantic.max_depth_m", 20.0, 1000.0, "depths above count as invalid"),
+    detail::positive("semantic.bin_m", 0.1, 10.0, "histogram bin width (m) for the person-depth mode"),
+    detail::real("semantic.peak_fraction", 0.15, 0.0, 1.0, "share of a box's depth samples a histogram peak needs", {}, "("),
+    detail::integer("semantic.sample_step", 2, 1, 64, "depth samples every n-th pixel inside a box"),
+    detail::real("semantic.silhouette_margin_px", 0.0, 0.0, 1000.0, "drop background keypoints this close (pixels) to the person's pixels; 0 = off"),
+    detail::real("semantic.min_exclusive_share", 1.0, 0.0, 1.0, "overlapping boxes also get a person depth from their own part when it holds this share; 1 = off"),
+    detail::flag("semantic.asynchronous", true, "real-time mode: detection on its own thread, tracking uses the freshest boxes (deterministic mode always waits)"),
+    detail::flag("semantic.propagate_boxes", true, "shift stale boxes by optical flow"),
+    detail::flag("semantic.mask_extraction", true, "extract no keypoints on the people, so their share of the budget goes to the background"),
+};
+// clang-format on
+
+/// Sections of the registry (the part of a key before the dot), in table order.
+inline constexpr std::string_view kSections[] = {"camera",   "depth", "orb",            "features", "tracking",
+                                                 "mapping",  "loop",  "relocalization", "semantic"};
+
+/// ORB-SLAM3 / ORB-SLAM2 keys that varslam reads nothing from: accepted in settings files, never an error.
+/// An entry ending in '.' covers every key with that prefix.
+inline constexpr std::string_view kIgnoredForeignKeys[] = {
+    "File.version", "Camera.type", "Camera.RGB", "Camera.newWidth", "Camera.newHeight", "Camera.bFishEye",
+    "Stereo.T_c1_c2", "Tbc", "Viewer.", "System.", "IMU.", "Camera2.", "LoopClosing.", "Tracking.", "PointCloudMapping."};
+
+constexpr std::span<const KeySpec> all() { return kKeys; }
+
+/// The key's declaration; nullptr when it is not declared.
+constexpr const KeySpec* find(std::string_view name) {
+  for (const KeySpec& k : kKeys)
+    if (k.name == name) return &k;
+  return nullptr;
+}
+
+/// Compile-time defaults for the config structs: a name that is not declared, or of another type, does not compile.
+consteval const KeySpec& spec(std::string_view name) {
+  const KeySpec* k = find(name);
+  if (!k) throw "setting_keys: key not declared in kKeys";
+  return *k;
+}
+consteval int int_default(std::string_view name) {
+  const KeySpec& k = spec(name);
+  if (k.type != KeyType::Int) throw "setting_keys: not an integer key";
+  return static_cast<int>(k.number);
+}
+consteval double real_default(std::string_view name) {
+  const KeySpec& k = spec(name);
+  if (k.type != KeyType::Real || !k.has_default) throw "setting_keys: not a real key with a default";
+  return k.number;
+}
+consteval bool bool_default(std::string_view name) {
+  const KeySpec& k = spec(name);
+  if (k.type != KeyType::Bool) throw "setting_keys: not a boolean key";
+  return k.number != 0.0;
+}
+consteval std::string_view text_default(std::string_view name) {
+  const KeySpec& k = spec(name);
+  if (k.type == KeyType::Int || k.type == KeyType::Real || k.type == KeyType::Bool)
+    throw "setting_keys: not a text key";
+  return k.text;
+}
+
+/// Defaults of list and map keys ("a,b" and "from:to,from:to" in the table) as the structs hold them.
+inline std::vector<std::string> list_default(std::string_view name) {
+  std::vector<std::string> out;
+  std::string_view text = find(name)->text;
+  while (!text.empty()) {
+    const auto comma = text.find(',');
+    out.emplace_back(text.substr(0, comma));
+    text = comma == std::string_view::npos ? std::string_view{} : text.substr(comma + 1);
+  }
+  return out;
+}
+inline std::map<std::string, std::string> map_default(std::string_view name) {
+  std::map<std::string, std::string> out;
+  for (const std::string& pair : list_default(name)) {
+    const auto colon = pair.find(':');
+    out[pair.substr(0, colon)] = colon == std::string::npos ? std::string() : pair.substr(colon + 1);
+  }
+  return out;
+}
+
+}  // namespace varslam::setting_keys
