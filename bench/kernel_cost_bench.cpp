@@ -28,8 +28,8 @@
 #include "io/trajectory_io.hpp"
 #include "optim/local_ba.hpp"
 #include "optim/pose_optimizer.hpp"
+#include "run/metrics_recorder.hpp"
 #include "slam/config.hpp"
-#include "slam/runner.hpp"
 #include "slam/system.hpp"
 
 namespace {
@@ -45,7 +45,7 @@ struct Options {
   std::vector<fs::path> sequences;
 };
 
-double median(std::vector<double> v) { return slam::median_p95(std::move(v)).first; }
+double median(std::vector<double> v) { return run::median_p95(std::move(v)).first; }
 
 double mean(const std::vector<double>& v) {
   double s = 0;
@@ -92,7 +92,13 @@ ArmRun run_arm(const std::vector<RgbdFrame>& frames, const Settings& settings, s
                const std::optional<Trajectory>& groundtruth) {
   cfg.tracking.kernel.type = arm.tracking;
   cfg.mapping.kernel.type = arm.mapping;
-  slam::System system(cfg, settings.camera, settings.close_depth_m(), slam::RunMode::Deterministic);
+  struct BaTimes final : slam::SystemObserver {
+    std::vector<double> ms;
+    void on_keyframe_mapped(const slam::KeyframeMapped& m) override {
+      if (m.ba) ms.push_back(m.ba->ms);
+    }
+  } ba_times;
+  slam::System system(cfg, settings.camera, settings.close_depth_m(), slam::RunMode::Deterministic, &ba_times);
   std::vector<double> track, track_cpu, pose, ba;
   for (const RgbdFrame& f : frames) {
     const double c0 = process_cpu_ms();
@@ -103,7 +109,7 @@ ArmRun run_arm(const std::vector<RgbdFrame>& frames, const Settings& settings, s
     if (!out.keyframe) track_cpu.push_back(cpu);  // a keyframe's process() also ran local mapping
   }
   system.finish();
-  for (const auto& b : system.mapping_stats().ba) ba.push_back(b.ms);
+  ba = ba_times.ms;
   ArmRun r;
   r.tracking_ms = median(track);
   r.tracking_cpu_ms = median(track_cpu);

@@ -17,7 +17,7 @@ void write_report_for_run(const std::filesystem::path& run_dir, const std::files
   }
 }
 
-void print_run_summary(const slam::RunSummary& s) {
+void print_run_summary(const run::RunSummary& s) {
   fmt::print("frames           {}\n", s.frames);
   fmt::print("tracked          {} ({:.1f}%), lost {}, map segments {}\n", s.tracked,
              s.frames ? 100.0 * s.tracked / s.frames : 0.0, s.lost, s.segments);

@@ -5,7 +5,7 @@
 
 #include "io/settings.hpp"
 #include "io/settings_registry.hpp"
-#include "slam/runner.hpp"
+#include "run/dataset_run.hpp"
 
 namespace varslam::cli {
 
@@ -13,6 +13,6 @@ namespace varslam::cli {
 void write_report_for_run(const std::filesystem::path& run_dir, const std::filesystem::path& sequence_dir);
 
 /// One human-readable block: frames, tracking share, keyframes, speed, ATE, and where the files went.
-void print_run_summary(const slam::RunSummary& s);
+void print_run_summary(const run::RunSummary& s);
 
 }  // namespace varslam::cli

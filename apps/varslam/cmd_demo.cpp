@@ -52,12 +52,11 @@ void add_demo_command(CLI::App& app) {
                                           "tracking.kernel=barron-fixed", "mapping.kernel=barron-adaptive"};
     overrides.insert(overrides.end(), o->overrides.begin(), o->overrides.end());
     apply_setting_overrides(settings, overrides);
-    const slam::SlamConfig cfg = slam::slam_config_from(settings);
     auto dataset = open_dataset(data, settings);
-    slam::RunOptions ro;
-    ro.mode = o->realtime ? slam::RunMode::RealTime : slam::RunMode::Deterministic;
+    run::RunOptions ro;
+    ro.mode = o->realtime ? RunMode::RealTime : RunMode::Deterministic;
     fmt::print("Running SLAM on it\n");
-    const slam::RunSummary s = slam::run_slam(*dataset, settings, cfg, ro, root / "run");
+    const run::RunSummary s = run::run_slam(*dataset, settings, ro, root / "run");
     write_report_for_run(s.out_dir, data);
     print_run_summary(s);
   });

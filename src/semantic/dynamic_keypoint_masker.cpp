@@ -31,6 +31,15 @@ void DynamicKeypointMasker::boxes_for(const RgbdFrame& frame) {
   if (current_frame_ == id) return;
   current_frame_ = id;
   const cv::Mat& image = frame.bgr.empty() ? frame.gray : frame.bgr;
+  if (given_) {
+    MaskResult out;
+    out.have_detections = true;
+    out.boxes = std::move(*given_);
+    given_.reset();
+    people_ = locate_people(image.size(), frame.depth, out.boxes, settings_.filter);
+    current_ = std::move(out);
+    return;
+  }
   async_.submit(image, frame.timestamp);
   if (!settings_.asynchronous) async_.wait_idle();
 

@@ -36,6 +36,10 @@ class DynamicKeypointMasker {
   /// are none). Call before process() on the same frame: both use the same boxes, found once.
   cv::Mat extraction_mask(const RgbdFrame& frame);
 
+  /// Boxes for the next frame processed, given by the caller (e.g. from its own detector): that frame uses them
+  /// as they are, and the detector does not run on it.
+  void give_boxes(Detections boxes) { given_ = std::move(boxes); }
+
   /// Blocks until the detector has finished every submitted frame.
   void wait_for_detector() { async_.wait_idle(); }
   std::string detector_name() const { return async_.name(); }
@@ -56,6 +60,7 @@ class DynamicKeypointMasker {
   std::optional<std::pair<std::size_t, double>> current_frame_;  // (index, timestamp)
   AsyncDetector async_;
   std::deque<PastGray> history_;  // recent gray images, to propagate boxes from the image they were found in
+  std::optional<Detections> given_;  // the caller's boxes for the next frame
 };
 
 }  // namespace varslam::semantic

@@ -42,7 +42,12 @@ LocalMapper::LocalMapper(const MappingConfig& cfg, Map& map, std::shared_ptr<con
 
 LocalMapper::~LocalMapper() { stop(); }
 
-bool LocalMapper::accepts_keyframes() const { return !busy_.load() && queued() == 0; }
+bool LocalMapper::accepts_keyframes() const { return !failed_.load() && !busy_.load() && queued() == 0; }
+
+std::exception_ptr LocalMapper::failure() const {
+  std::lock_guard lock(queue_mutex_);
+  return failure_;
+}
 
 std::size_t LocalMapper::queued() const {
   std::lock_guard lock(queue_mutex_);
@@ -95,19 +100,27 @@ void LocalMapper::run() {
       queue_.pop_front();
       busy_ = true;
     }
-    process(kf);
+    try {
+      process(kf);
+    } catch (...) {
+      // Reaches the caller through failure() (System::process rethrows it); mapping stops here.
+      std::lock_guard lock(queue_mutex_);
+      failure_ = std::current_exception();
+      failed_ = true;
+      queue_.clear();
+      busy_ = false;
+      return;
+    }
     busy_ = false;
   }
-}
-
-MappingStats LocalMapper::stats() const {
-  std::lock_guard lock(stats_mutex_);
-  return stats_;
 }
 
 void LocalMapper::process(const KeyFramePtr& kf) {
   const auto t0 = Clock::now();
   abort_ba_ = false;
+  current_ = KeyframeMapped{};
+  current_.keyframe_id = kf->id();
+  current_.timestamp = kf->timestamp();
   add_observations(kf);
   cull_recent_points(kf);
   triangulate(kf);
@@ -117,10 +130,8 @@ void LocalMapper::process(const KeyFramePtr& kf) {
     if (cfg_.cull_keyframes) cull_keyframes(kf);
   }
   remove_bad_from_map();
-  {
-    std::lock_guard lock(stats_mutex_);
-    stats_.keyframe_ms.push_back(ms_since(t0));
-  }
+  current_.ms = ms_since(t0);
+  if (observer_) observer_->on_keyframe_mapped(current_);
   if (keyframe_done_) keyframe_done_(kf);
 }
 
@@ -158,8 +169,7 @@ void LocalMapper::cull_recent_points(const KeyFramePtr& kf) {
       ++it;
     }
   }
-  std::lock_guard lock(stats_mutex_);
-  stats_.culled_points += culled;
+  current_.culled_points += culled;
 }
 
 void LocalMapper::triangulate(const KeyFramePtr& kf) {
@@ -217,8 +227,7 @@ void LocalMapper::triangulate(const KeyFramePtr& kf) {
       ++created;
     }
   }
-  std::lock_guard lock(stats_mutex_);
-  stats_.triangulated_points += created;
+  current_.triangulated_points += created;
 }
 
 void LocalMapper::fuse_neighbours(const KeyFramePtr& kf) {
@@ -348,8 +357,7 @@ void LocalMapper::local_ba(const KeyFramePtr& kf) {
   }
   rec.refine_alpha = res.final_alpha;
   rec.ms = ms_since(t0);
-  std::lock_guard lock(stats_mutex_);
-  stats_.ba.push_back(std::move(rec));
+  current_.ba = std::move(rec);
 }
 
 void LocalMapper::cull_keyframes(const KeyFramePtr& kf) {
@@ -379,8 +387,7 @@ void LocalMapper::cull_keyframes(const KeyFramePtr& kf) {
       ++culled;
     }
   }
-  std::lock_guard lock(stats_mutex_);
-  stats_.culled_keyframes += culled;
+  current_.culled_keyframes += culled;
 }
 
 void LocalMapper::remove_bad_from_map() {

@@ -4,6 +4,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <deque>
+#include <exception>
 #include <functional>
 #include <list>
 #include <mutex>
@@ -12,29 +13,10 @@
 
 #include "slam/config.hpp"
 #include "slam/map.hpp"
+#include "slam/system_events.hpp"
 #include "slam/tracking.hpp"
 
 namespace varslam::slam {
-
-/// What one Local BA did (for the run's metrics and the alpha-per-keyframe plot).
-struct BaRecord {
-  long keyframe_id = 0;
-  double timestamp = 0;
-  int keyframes = 0, fixed_keyframes = 0, points = 0, observations = 0, outliers = 0;
-  std::vector<double> alpha_per_iteration;
-  double final_alpha = 2.0;   // alpha of the last alternation before the outlier gate
-  double fitted_alpha = 2.0;  // the fit behind final_alpha, before mapping.alpha_max capped it
-  double refine_alpha = 2.0;  // alpha of the refine solve on the gated inliers
-  double ms = 0;
-};
-
-struct MappingStats {
-  std::vector<double> keyframe_ms;  // whole processing of one keyframe
-  std::vector<BaRecord> ba;
-  int triangulated_points = 0;
-  int culled_points = 0;
-  int culled_keyframes = 0;
-};
 
 class LocalMapper final : public KeyframeSink {
  public:
@@ -54,7 +36,10 @@ class LocalMapper final : public KeyframeSink {
   /// Finishes the queued keyframes and joins the thread.
   void stop();
 
-  MappingStats stats() const;
+  /// Receives a KeyframeMapped record per processed keyframe, on the mapping thread. Set before start().
+  void set_observer(SystemObserver* observer) { observer_ = observer; }
+  /// The exception that ended the mapping thread (real-time mode), if any; the thread stops taking keyframes.
+  std::exception_ptr failure() const;
 
   /// Called in the mapping thread after each keyframe is processed (loop closing plugs in here).
   void set_keyframe_done(std::function<void(const KeyFramePtr&)> fn) { keyframe_done_ = std::move(fn); }
@@ -85,8 +70,10 @@ class LocalMapper final : public KeyframeSink {
 
   std::function<void(const KeyFramePtr&)> keyframe_done_;
   std::list<MapPointPtr> recent_points_;
-  mutable std::mutex stats_mutex_;
-  MappingStats stats_;
+  KeyframeMapped current_;  // the record of the keyframe being processed (mapping thread only)
+  SystemObserver* observer_ = nullptr;
+  std::exception_ptr failure_;  // written by the mapping thread under queue_mutex_
+  std::atomic<bool> failed_{false};
 };
 
 }  // namespace varslam::slam

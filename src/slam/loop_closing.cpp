@@ -55,11 +55,6 @@ std::vector<LoopRecord> LoopCloser::loops() const {
   return records_;
 }
 
-std::vector<double> LoopCloser::detection_ms() const {
-  std::lock_guard lock(records_mutex_);
-  return detection_ms_;
-}
-
 bool LoopCloser::process(const KeyFramePtr& kf) {
   if (kf->is_bad()) return false;
   std::optional<Detection> det;
@@ -67,8 +62,7 @@ bool LoopCloser::process(const KeyFramePtr& kf) {
       map_.num_keyframes() >= static_cast<std::size_t>(cfg_.min_keyframes)) {
     const auto t_detect = Clock::now();
     det = detect(kf);
-    std::lock_guard lock(records_mutex_);
-    detection_ms_.push_back(ms_since(t_detect));
+    if (observer_) observer_->on_loop_search({kf->id(), ms_since(t_detect)});
   }
   places_.add(kf);
   if (!det) return false;
@@ -87,8 +81,11 @@ bool LoopCloser::process(const KeyFramePtr& kf) {
                rec.query_keyframe, rec.timestamp, rec.loop_keyframe, rec.inliers, rec.correction_m, rec.correction_deg,
                rec.total_ms);
   last_loop_kf_ = kf->id();
-  std::lock_guard lock(records_mutex_);
-  records_.push_back(rec);
+  {
+    std::lock_guard lock(records_mutex_);
+    records_.push_back(rec);
+  }
+  if (observer_) observer_->on_loop_closed(rec);
   return true;
 }
 
@@ -123,7 +120,7 @@ bool LoopCloser::verify(const KeyFramePtr& kf, const PlaceCandidate& cand, Detec
   for (const auto& g : loop_group)
     for (const auto& mp : g->map_points())
       if (mp && !mp->is_bad() && seen.insert(mp->id()).second) loop_points.push_back(mp);
-  match_local_map(f, loop_points, 1.0, /*count_visible=*/false);
+  match_local_map(f, loop_points, 1.0, LocalMapUse::Verification);
   const int inliers = refine_pose_on_matches(f, pose_kernel_);
   spdlog::debug("loop candidate {} for keyframe {}: score {}, ransac {}, guided inliers {}", cand.keyframe->id(),
                 kf->id(), cand.score, ransac_inliers, inliers);
@@ -150,7 +147,7 @@ bool LoopCloser::loop_side_agrees_with_own_pose(const KeyFramePtr& kf, const std
   // loop pose follows something that moved between the two visits (a box held in front of the camera).
   if (cfg_.max_own_pose_share <= 0) return false;
   Frame g = frame_of(*kf);
-  match_local_map(g, loop_points, 1.0, /*count_visible=*/false);
+  match_local_map(g, loop_points, 1.0, LocalMapUse::Verification);
   const int own_inliers = refine_pose_on_matches(g, pose_kernel_);
   const Eigen::Vector3d refined = g.T_cw.inverse().translation();
   const bool stays_at_own = (kf->camera_center() - refined).norm() < (T_cw_loop.inverse().translation() - refined).norm();

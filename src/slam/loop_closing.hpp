@@ -14,17 +14,9 @@
 #include "slam/config.hpp"
 #include "slam/keyframe_database.hpp"
 #include "slam/map.hpp"
+#include "slam/system_events.hpp"
 
 namespace varslam::slam {
-
-/// One closed loop (for the run's metrics).
-struct LoopRecord {
-  long query_keyframe = 0, loop_keyframe = 0;
-  double timestamp = 0;
-  int score = 0, ransac_inliers = 0, inliers = 0, fused_points = 0;
-  double correction_m = 0, correction_deg = 0;  // how far the query keyframe moved
-  double pose_graph_ms = 0, global_ba_ms = 0, total_ms = 0;
-};
 
 class LoopCloser {
  public:
@@ -34,9 +26,10 @@ class LoopCloser {
   /// Adds the keyframe to the place database, then looks for and closes a loop; true when one was closed.
   bool process(const KeyFramePtr& kf);
 
+  /// Every loop closed so far.
   std::vector<LoopRecord> loops() const;
-  /// Milliseconds spent looking for a loop (place query and verification), per keyframe processed.
-  std::vector<double> detection_ms() const;
+  /// Receives a LoopSearch per loop search and a LoopRecord per closed loop, on the thread calling process().
+  void set_observer(SystemObserver* observer) { observer_ = observer; }
 
   /// Bundle adjustment of the whole map (Huber); returns its milliseconds.
   double run_global_ba();
@@ -72,7 +65,7 @@ class LoopCloser {
   std::vector<std::pair<KeyFramePtr, KeyFramePtr>> loop_links_;  // every loop edge so far (stays in the graph)
   mutable std::mutex records_mutex_;
   std::vector<LoopRecord> records_;
-  std::vector<double> detection_ms_;
+  SystemObserver* observer_ = nullptr;
 };
 
 }  // namespace varslam::slam

@@ -69,11 +69,12 @@ class MapPoint {
     return num_observations() > 0 && found() >= min_found && frame_id - first_frame_id_ >= min_age;
   }
 
-  // Per-frame scratch used by tracking only (tracking thread).
+  // Per-frame scratch owned by the tracking thread: no other thread reads or writes these two (loop verification
+  // matches with LocalMapUse::Verification, which leaves them alone).
   long track_reference_frame = -1;  // last frame id it was added to the local map for
   long last_seen_frame = -1;        // last frame id it was matched in
-  long fuse_candidate_kf = -1;      // local mapping scratch
-  long ba_local_kf = -1;            // local mapping scratch
+  long fuse_candidate_kf = -1;      // local mapping scratch (mapping thread, which loop closing runs on)
+  long ba_local_kf = -1;            // local mapping scratch (mapping thread)
 
  private:
   /// Marks the point bad and hands back its observations; nullopt if it already was bad.

@@ -103,14 +103,15 @@ int match_last_frame(Frame& cur, const Frame& last, double radius) {
   return n;
 }
 
-int match_local_map(Frame& cur, const std::vector<MapPointPtr>& points, double radius_scale, bool count_visible) {
+int match_local_map(Frame& cur, const std::vector<MapPointPtr>& points, double radius_scale, LocalMapUse use) {
+  const bool tracking = use == LocalMapUse::Tracking;
   const FrameFeatures& F = *cur.features;
   const ScaleInfo& S = *F.scale;
   const Eigen::Isometry3d T_wc = cur.T_cw.inverse();
   const Eigen::Vector3d center = T_wc.translation();
   int n = 0;
   for (const MapPointPtr& mp : points) {
-    if (mp->is_bad() || mp->last_seen_frame == cur.id) continue;
+    if (mp->is_bad() || (tracking && mp->last_seen_frame == cur.id)) continue;
     const Eigen::Vector3d pw = mp->position();
     const Eigen::Vector3d pc = cur.T_cw * pw;
     if (pc.z() <= 0) continue;
@@ -122,7 +123,7 @@ int match_local_map(Frame& cur, const std::vector<MapPointPtr>& points, double r
     const Eigen::Vector3d nrm = mp->normal();
     const double view_cos = nrm.norm() > 0 ? ray.dot(nrm) / (dist * nrm.norm()) : 1.0;
     if (view_cos < 0.5) continue;
-    if (count_visible) mp->increase_visible();
+    if (tracking) mp->increase_visible();
     const int level = mp->predict_scale(dist, S.log_scale_factor, S.n_levels);
     const double r = radius_scale * (view_cos > 0.998 ? 2.5 : 4.0) * S.scale_factors[level];
     const std::vector<int> cands = F.in_area(uv.x(), uv.y(), r, level - 1, level);

@@ -16,11 +16,15 @@ inline constexpr int kDescDistLow = 50;    // strict distance for fusing and tri
 /// 0, scaled by the keypoint's level. Returns the number of new matches.
 int match_last_frame(Frame& cur, const Frame& last, double radius);
 
+/// Who projects local map points: tracking (its thread owns the points' per-frame scratch and their visibility
+/// counts) or a check on another thread, like loop verification, which must read and touch neither.
+enum class LocalMapUse { Tracking, Verification };
+
 /// Projects local map points into `cur` (frustum and viewing-angle checks, scale prediction) and matches the
-/// ones not matched yet. Marks visited points visible (unless `count_visible` is false: a check that is not
-/// tracking, like loop verification, must not touch the points' tracking statistics). `radius_scale` widens the
-/// search (e.g. after a loss).
-int match_local_map(Frame& cur, const std::vector<MapPointPtr>& points, double radius_scale, bool count_visible = true);
+/// ones not matched yet. For tracking, skips points already matched in this frame (MapPoint::last_seen_frame)
+/// and marks visited points visible. `radius_scale` widens the search (e.g. after a loss).
+int match_local_map(Frame& cur, const std::vector<MapPointPtr>& points, double radius_scale,
+                    LocalMapUse use = LocalMapUse::Tracking);
 
 /// Descriptor matching of the keyframe's map points against all of the frame's keypoints (ratio test,
 /// rotation consistency); the fallback when the motion model fails.

@@ -2,13 +2,16 @@
 
 namespace varslam::slam {
 
-System::System(const SlamConfig& cfg, const PinholeCamera& camera, double close_depth, RunMode mode)
+System::System(const SlamConfig& cfg, const PinholeCamera& camera, double close_depth, RunMode mode,
+               SystemObserver* observer)
     // The tracker only stores its keyframe sink here; the mapper takes the pyramid facts from the tracker's
     // extractor, so both stages use one ScaleInfo.
     : cfg_(cfg), mode_(mode), tracker_(cfg, camera, close_depth, map_, mapper_),
       mapper_(cfg.mapping, map_, tracker_.scale(), close_depth),
       loop_(cfg.loop, cfg.tracking.kernel, map_, places_, tracker_.scale()) {
   tracker_.set_place_database(&places_);
+  mapper_.set_observer(observer);
+  loop_.set_observer(observer);
   mapper_.set_keyframe_done([this](const KeyFramePtr& kf) { loop_.process(kf); });
   if (mode_ == RunMode::RealTime) mapper_.start();
 }
@@ -19,6 +22,7 @@ System::~System() {
 }
 
 TrackOutcome System::process(const RgbdFrame& frame) {
+  if (const auto failure = mapper_.failure()) std::rethrow_exception(failure);
   TrackOutcome out = tracker_.track(frame);
   if (mode_ == RunMode::Deterministic) mapper_.process_all();
   return out;
@@ -26,6 +30,7 @@ TrackOutcome System::process(const RgbdFrame& frame) {
 
 void System::finish() {
   mapper_.stop();
+  if (const auto failure = mapper_.failure()) std::rethrow_exception(failure);
   if (cfg_.loop.final_global_ba) loop_.run_global_ba();
 }
 

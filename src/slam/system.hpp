@@ -16,26 +16,19 @@ namespace varslam::slam {
 
 enum class RunMode { Deterministic, RealTime };
 
-/// Per-frame log entry for the metrics.
-struct FrameLog {
-  double timestamp = 0;
-  TrackState state = TrackState::NotInitialized;
-  bool keyframe = false, new_segment = false;
-  int keypoints = 0, inliers = 0, depth_edge_rejected = 0;
-  double load_ms = 0;
-  FrameTimings timings;
-};
-
 class System {
  public:
-  System(const SlamConfig& cfg, const PinholeCamera& camera, double close_depth, RunMode mode);
+  /// `observer` (may be null) receives the mapping and loop records, from the thread that made them.
+  System(const SlamConfig& cfg, const PinholeCamera& camera, double close_depth, RunMode mode,
+         SystemObserver* observer = nullptr);
   ~System();
   System(const System&) = delete;
   System& operator=(const System&) = delete;
 
-  /// Tracks one frame (and, in deterministic mode, runs local mapping on any keyframe it made).
+  /// Tracks one frame (and, in deterministic mode, runs local mapping on any keyframe it made). An exception
+  /// that stopped the mapping thread (real-time mode) is rethrown here.
   TrackOutcome process(const RgbdFrame& frame);
-  /// Finishes local mapping (real-time mode) so the map is final.
+  /// Finishes local mapping (real-time mode) so the map is final; rethrows a mapping thread's exception.
   void finish();
 
   void set_keypoint_filter(KeypointFilterFn fn) { tracker_.set_keypoint_filter(std::move(fn)); }
@@ -47,9 +40,7 @@ class System {
   const Map& map() const { return map_; }
   Map& map() { return map_; }
   const Tracker& tracker() const { return tracker_; }
-  MappingStats mapping_stats() const { return mapper_.stats(); }
   std::vector<LoopRecord> loops() const { return loop_.loops(); }
-  std::vector<double> loop_detection_ms() const { return loop_.detection_ms(); }
   RunMode mode() const { return mode_; }
 
  private:

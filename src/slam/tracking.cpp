@@ -7,6 +7,7 @@
 #include <cmath>
 #include <mutex>
 #include <shared_mutex>
+#include <utility>
 
 #include "optim/pose_optimizer.hpp"
 #include "slam/ba_problem_builder.hpp"
@@ -90,6 +91,7 @@ TrackOutcome Tracker::track(const RgbdFrame& input) {
     record(cur, state_ == TrackState::Ok);
     out.state = state_;
     if (state_ == TrackState::Ok) out.live_T_wc = cur.T_cw.inverse();
+    if (out.keyframe && cur.reference_kf) out.keyframe_id = cur.reference_kf->id();
     out.timings.track_ms = ms_since(t_start);
     last_ = cur;
     return out;
@@ -142,6 +144,8 @@ TrackOutcome Tracker::track(const RgbdFrame& input) {
   }
   out.state = state_;
   if (state_ == TrackState::Ok) out.live_T_wc = cur.T_cw.inverse();
+  if (out.keyframe && cur.reference_kf) out.keyframe_id = cur.reference_kf->id();
+  out.relocalized = std::exchange(relocalized_, std::nullopt);
   last_ = cur;
   last_is_keyframe_ = out.keyframe;
   out.timings.track_ms = ms_since(t_start);
@@ -342,6 +346,7 @@ bool Tracker::relocalize(Frame& cur, FrameTimings& t) {
     reference_kf_ = cand.keyframe;
     cur.reference_kf = cand.keyframe;
     ++relocalizations_;
+    relocalized_ = Relocalization{cand.keyframe->id(), inliers, cand.score};
     spdlog::info("relocalized at t={:.3f} against keyframe {} ({} inliers, place score {})", cur.timestamp,
                  cand.keyframe->id(), inliers, cand.score);
     return true;

@@ -37,9 +37,17 @@ struct FrameTimings {
   double extract_ms = 0, filter_ms = 0, match_ms = 0, pose_ms = 0, track_ms = 0;
 };
 
+/// A frame located by global relocalization against a place candidate.
+struct Relocalization {
+  long keyframe_id = 0;  // the candidate it was located against
+  int inliers = 0;
+  int place_score = 0;   // signature matches (of 256)
+};
+
 struct TrackOutcome {
   TrackState state = TrackState::NotInitialized;
   bool keyframe = false;
+  long keyframe_id = -1;     // the keyframe this frame became (keyframe == true)
   bool new_segment = false;  // tracking was lost and a new map segment started at the predicted pose
   int inliers = 0;
   int keypoints = 0;
@@ -48,6 +56,7 @@ struct TrackOutcome {
   // The pose tracking gave the frame, camera-to-world, as a live user gets it (later BA and loop corrections move
   // the frame's pose in the final trajectory, not this); empty when the frame was not tracked.
   std::optional<Eigen::Isometry3d> live_T_wc;
+  std::optional<Relocalization> relocalized;  // set on the frame global relocalization found
 };
 
 /// Pose of a frame kept relative to its reference keyframe, so later keyframe corrections (BA) move it too.
@@ -120,6 +129,7 @@ class Tracker {
   int lost_count_ = 0;
   int segments_ = 0;
   int relocalizations_ = 0;
+  std::optional<Relocalization> relocalized_;  // of the frame being tracked, moved into its TrackOutcome
   long seen_corrections_ = 0;  // map_.corrections() when the last frame was last re-anchored
   std::vector<KeyFramePtr> local_keyframes_;
   std::vector<MapPointPtr> local_points_;

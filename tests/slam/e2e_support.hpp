@@ -7,7 +7,8 @@
 #include <string>
 
 #include "io/dataset.hpp"
-#include "slam/runner.hpp"
+#include "io/settings_registry.hpp"
+#include "run/dataset_run.hpp"
 #include "synth/synth.hpp"
 
 namespace varslam::slam::e2e {
@@ -30,18 +31,17 @@ inline fs::path cached_sequence(const std::string& name, synth::SynthConfig cfg)
   return d;
 }
 
-/// Runs SLAM with the dataset's settings (adjusted by `adjust`) and writes into `out`.
-inline RunSummary run_on(const fs::path& data, const fs::path& out, RunMode mode = RunMode::Deterministic,
-                         std::size_t max_frames = SIZE_MAX, const std::function<void(SlamConfig&)>& adjust = {}) {
+/// Runs SLAM with the dataset's settings (plus `overrides`, as --set takes them) and writes into `out`.
+inline run::RunSummary run_on(const fs::path& data, const fs::path& out, RunMode mode = RunMode::Deterministic,
+                         std::size_t max_frames = SIZE_MAX, const std::vector<std::string>& overrides = {}) {
   Settings settings = settings_for_dataset(data, std::nullopt);
-  SlamConfig cfg = slam_config_from(settings);
-  if (adjust) adjust(cfg);
+  apply_setting_overrides(settings, overrides);
   auto ds = open_dataset(data, settings);
-  RunOptions ro;
+  run::RunOptions ro;
   ro.mode = mode;
   ro.progress = false;
   ro.max_frames = max_frames;
-  return run_slam(*ds, settings, cfg, ro, out);
+  return run::run_slam(*ds, settings, ro, out);
 }
 
 }  // namespace varslam::slam::e2e

@@ -17,6 +17,9 @@ namespace varslam::slam {
 namespace {
 
 namespace fs = std::filesystem;
+using run::RunOptions;
+using run::RunSummary;
+using run::run_slam;
 using e2e::cached_sequence;
 using e2e::run_on;
 
@@ -121,13 +124,12 @@ TEST(EndToEnd, PeopleFilteredFromFarBackgroundKeepThePose) {
   Settings settings = settings_for_dataset(seq, std::nullopt);
   settings.root["semantic"]["detector"] = "boxes";
   settings.root["semantic"]["boxes_file"] = "boxes.txt";
-  const SlamConfig slam = slam_config_from(settings);
-  ASSERT_GT(slam.tracking.disparity_weight, 0.0) << "the default depth residual is the disparity one";
+  ASSERT_GT(slam_config_from(settings).tracking.disparity_weight, 0.0) << "the default depth residual is the disparity one";
   auto ds = open_dataset(seq, settings);
   RunOptions ro;
   ro.progress = false;
   ro.max_frames = 30;
-  expect_tracked_with_ate_below(run_slam(*ds, settings, slam, ro, test_dir("far_background")), 0.025);
+  expect_tracked_with_ate_below(run_slam(*ds, settings, ro, test_dir("far_background")), 0.025);
 }
 
 // A 38 cm box flies past 2 m away at 0.95 m/s in front of a wall 5 m away (unknown_box, fr3_sitting_static

@@ -19,6 +19,9 @@ namespace varslam::slam {
 namespace {
 
 namespace fs = std::filesystem;
+using run::RunOptions;
+using run::RunSummary;
+using run::run_slam;
 
 struct ListEntry {
   std::string stamp, rest;
@@ -81,10 +84,10 @@ std::vector<int> operator+(std::vector<int> a, const std::vector<int>& b) {
 }
 
 RunSummary run_named(const fs::path& data, const std::string& name,
-                     const std::function<void(SlamConfig&)>& adjust = {}) {
+                     const std::vector<std::string>& overrides = {}) {
   const fs::path out = fs::temp_directory_path() / ("varslam_recovery_out_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(out);
-  return e2e::run_on(data, out, RunMode::Deterministic, SIZE_MAX, adjust);
+  return e2e::run_on(data, out, RunMode::Deterministic, SIZE_MAX, overrides);
 }
 
 fs::path static_sequence() {
@@ -132,7 +135,7 @@ TEST_F(KidnappedInKitchen, RelocalizationPutsTheCameraBackIntoTheMap) {
 }
 
 TEST_F(KidnappedInKitchen, LoopClosingMergesTheNewSegmentIntoTheOldMap) {
-  const RunSummary s = run_named(seq_, "kitchen_loop", [](SlamConfig& c) { c.relocalization.enabled = false; });
+  const RunSummary s = run_named(seq_, "kitchen_loop", {"relocalization.enabled=false"});
   EXPECT_EQ(s.segments, 2);
   ASSERT_GE(s.metrics.at("loops").size(), 1u);
   EXPECT_EQ(s.metrics.at("loops")[0].at("loop_keyframe").get<long>(), 0);

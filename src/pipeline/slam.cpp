@@ -1,0 +1,286 @@
+#include "pipeline/slam.hpp"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <opencv2/imgproc.hpp>
+#include <variant>
+
+#include "core/error.hpp"
+#include "io/colour_registration.hpp"
+#include "io/depth_image.hpp"
+#include "semantic/dynamic_keypoint_masker.hpp"
+
+namespace varslam {
+namespace {
+using Clock = std::chrono::steady_clock;
+
+// Raw depth from a separate depth camera (7-Scenes, raw Kinect v1) misfits the colour edges; the settings'
+// intrinsics then describe the depth camera. When a zoom and shift clearly beats identity on the sample frames,
+// depth is warped into the colour camera it implies. Registered data (TUM, Bonn, synthetic) comes out as identity.
+DepthRegistrationEvent register_depth_if_needed(std::span<const RgbdFrame> samples, Settings& settings,
+                                                slam::SlamConfig& cfg) {
+  DepthRegistrationEvent ev;
+  if (cfg.tracking.depth_rig) {
+    ev.mode = "settings";
+    return ev;
+  }
+  if (!cfg.tracking.estimate_registration) {
+    ev.mode = "off";
+    return ev;
+  }
+  ev.mode = "auto";
+  const auto t0 = Clock::now();
+  std::vector<cv::Mat> grays, depths;
+  for (const RgbdFrame& f : samples) {
+    if (f.gray.empty() || f.depth.empty()) continue;
+    grays.push_back(f.gray);
+    depths.push_back(f.depth);
+  }
+  const ColourRegistration reg = estimate_colour_registration(grays, depths, settings.camera);
+  ev.found = reg.found;
+  ev.scale = reg.scale;
+  ev.du = reg.du;
+  ev.dv = reg.dv;
+  ev.score = reg.score;
+  ev.identity_score = reg.identity_score;
+  ev.frames = reg.frames;
+  ev.ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  if (reg.found) {
+    DepthCameraRig rig;
+    rig.depth = settings.camera;
+    settings.camera = reg.colour_camera(rig.depth);
+    cfg.tracking.depth_rig = rig;
+    ev.colour_camera = settings.camera;
+    spdlog::info("depth is not registered to colour (edge fit {:.2f} against {:.2f} as given): colour camera fx {:.1f} "
+                 "cx {:.1f} cy {:.1f}, depth warped into it (depth.registration: off to keep the images as they are)",
+                 reg.score, reg.identity_score, settings.camera.fx, settings.camera.cx, settings.camera.cy);
+  }
+  return ev;
+}
+
+// A frame of the caller's images, checked against the camera: gray for tracking, depth in metres.
+RgbdFrame frame_from_images(const cv::Mat& bgr, const cv::Mat& depth, double timestamp, std::size_t index,
+                            const Settings& settings) {
+  const PinholeCamera& cam = settings.camera;
+  const auto check_size = [&](const cv::Mat& m, const char* what) {
+    if (m.cols != cam.width || m.rows != cam.height)
+      throw InputError(fmt::format("Slam::track: {} image is {}x{}, the camera is {}x{}", what, m.cols, m.rows,
+                                   cam.width, cam.height));
+  };
+  RgbdFrame f;
+  f.index = index;
+  f.timestamp = timestamp;
+  if (bgr.empty()) throw InputError("Slam::track: empty colour image");
+  check_size(bgr, "colour");
+  if (bgr.type() == CV_8UC3) {
+    f.bgr = bgr;
+    cv::cvtColor(bgr, f.gray, cv::COLOR_BGR2GRAY);
+  } else if (bgr.type() == CV_8UC1) {
+    f.gray = bgr;
+    cv::cvtColor(bgr, f.bgr, cv::COLOR_GRAY2BGR);
+  } else {
+    throw InputError("Slam::track: the colour image must be CV_8UC3 (BGR) or CV_8UC1");
+  }
+  if (depth.empty()) throw InputError("Slam::track: empty depth image");
+  check_size(depth, "depth");
+  if (depth.type() == CV_16UC1) f.depth = depth_to_metres(depth, settings.depth_factor);
+  else if (depth.type() == CV_32FC1) f.depth = depth;
+  else throw InputError("Slam::track: the depth image must be CV_16UC1 (raw, depth.factor per metre) or CV_32FC1 (m)");
+  return f;
+}
+
+}  // namespace
+
+// Records from the stages, any thread -> a queue the caller's thread empties.
+class Slam::Relay final : public slam::SystemObserver {
+ public:
+  using Record = std::variant<slam::KeyframeMapped, slam::LoopSearch, slam::LoopRecord>;
+  void on_keyframe_mapped(const slam::KeyframeMapped& r) override { push(r); }
+  void on_loop_search(const slam::LoopSearch& r) override { push(r); }
+  void on_loop_closed(const slam::LoopRecord& r) override { push(r); }
+  std::vector<Record> take() {
+    std::lock_guard lock(mutex_);
+    return std::exchange(queue_, {});
+  }
+
+ private:
+  void push(Record r) {
+    std::lock_guard lock(mutex_);
+    queue_.push_back(std::move(r));
+  }
+  std::mutex mutex_;
+  std::vector<Record> queue_;
+};
+
+Slam::Slam(const Settings& settings, SlamOptions options)
+    : settings_(settings),
+      cfg_(slam::slam_config_from(settings)),
+      options_(std::move(options)),
+      semantic_(semantic::semantic_settings(settings)),
+      relay_(std::make_unique<Relay>()) {
+  // Deterministic mode waits for each frame's detections, so results do not depend on timing.
+  if (options_.mode == RunMode::Deterministic) semantic_.asynchronous = false;
+  if (options_.detector) {
+    // The caller's detector stays the caller's: the masker gets a forwarding one.
+    struct Shared final : semantic::Detector {
+      std::shared_ptr<semantic::Detector> d;
+      explicit Shared(std::shared_ptr<semantic::Detector> det) : d(std::move(det)) {}
+      Detections detect(const cv::Mat& bgr, double t) override { return d->detect(bgr, t); }
+      std::string name() const override { return d->name(); }
+    };
+    masker_ = std::make_unique<semantic::DynamicKeypointMasker>(std::make_unique<Shared>(options_.detector), semantic_);
+  } else if (semantic_.detector.source != "none") {
+    masker_ = std::make_unique<semantic::DynamicKeypointMasker>(semantic_);
+  }
+}
+
+Slam::~Slam() = default;
+
+void Slam::add_observer(Observer& observer) { observers_.push_back(&observer); }
+
+void Slam::remove_observer(Observer& observer) {
+  observers_.erase(std::remove(observers_.begin(), observers_.end(), &observer), observers_.end());
+}
+
+template <typename Event, typename Fn>
+void Slam::emit(const Event& e, Fn fn) {
+  for (Observer* o : observers_) (o->*fn)(e);
+}
+
+void Slam::calibrate_depth(std::span<const RgbdFrame> samples) {
+  if (system_) throw std::logic_error("Slam::calibrate_depth: call it before the first frame");
+  start(samples);
+}
+
+void Slam::start(std::span<const RgbdFrame> samples) {
+  const DepthRegistrationEvent reg = register_depth_if_needed(samples, settings_, cfg_);
+  system_ = std::make_unique<slam::System>(cfg_, settings_.camera, settings_.close_depth_m(), options_.mode,
+                                           relay_.get());
+  if (masker_) install_person_filter();
+  emit(reg, &Observer::on_depth_registration);
+}
+
+void Slam::install_person_filter() {
+  system_->set_keypoint_filter([this](const RgbdFrame& f, const std::vector<cv::KeyPoint>& kps) {
+    semantic::MaskResult r = masker_->process(f, kps);
+    DetectionEvent d;
+    d.source_index = f.index;
+    d.timestamp = f.timestamp;
+    d.have_detections = r.have_detections;
+    d.box_age_s = r.staleness_s;
+    d.detector_latency_s = r.detector_latency_s;
+    d.propagated = r.propagated;
+    d.boxes = std::move(r.boxes);
+    d.stats = r.stats;
+    d.keypoints = kps;
+    d.keep = r.keep;
+    d.bgr = f.bgr;
+    detection_ = std::move(d);
+    return r.keep;
+  });
+  if (semantic_.mask_extraction)
+    system_->set_extraction_mask([this](const RgbdFrame& f) { return masker_->extraction_mask(f); });
+}
+
+std::function<void(RgbdFrame&)> Slam::frame_preparation() const {
+  if (!cfg_.tracking.depth_rig) return [](RgbdFrame& f) { f.depth_in_colour_frame = true; };
+  return [rig = *cfg_.tracking.depth_rig, colour = settings_.camera](RgbdFrame& f) {
+    if (f.depth_in_colour_frame) return;
+    f.depth = register_depth_to_colour(f.depth, rig, colour);
+    f.depth_in_colour_frame = true;
+  };
+}
+
+FrameResult Slam::track(const cv::Mat& bgr, const cv::Mat& depth, double timestamp,
+                        const std::optional<Detections>& boxes) {
+  return track(frame_from_images(bgr, depth, timestamp, frames_, settings_), boxes);
+}
+
+FrameResult Slam::track(const RgbdFrame& input, const std::optional<Detections>& boxes) {
+  if (finished_) throw std::logic_error("Slam::track after finish()");
+  if (!system_) start(std::span<const RgbdFrame>(&input, 1));
+  RgbdFrame frame = input;
+  if (!frame.depth_in_colour_frame) frame_preparation()(frame);
+  if (boxes) {
+    if (!masker_) {  // no detector configured: the caller's boxes switch the person filter on
+      semantic::DetectorConfig none = semantic_.detector;
+      none.source = "none";
+      masker_ = std::make_unique<semantic::DynamicKeypointMasker>(semantic::make_detector(none), semantic_);
+      install_person_filter();
+    }
+    masker_->give_boxes(*boxes);
+  }
+
+  const slam::TrackOutcome out = system_->process(frame);
+  FrameResult r;
+  r.index = frames_++;
+  r.timestamp = frame.timestamp;
+  r.state = out.state;
+  r.keyframe = out.keyframe;
+  r.keyframe_id = out.keyframe_id;
+  r.new_segment = out.new_segment;
+  r.keypoints = out.keypoints;
+  r.inliers = out.inliers;
+  r.depth_edge_rejected = out.depth_edge_rejected;
+  r.timings = out.timings;
+  r.T_wc = out.live_T_wc;
+  r.map_keyframes = system_->map().num_keyframes();
+  r.map_points = system_->map().num_map_points();
+  if (out.live_T_wc) {
+    live_.push_back({frame.timestamp, *out.live_T_wc});
+    ++tracked_;
+  }
+
+  if (detection_) {
+    detection_->index = r.index;
+    emit(*std::exchange(detection_, std::nullopt), &Observer::on_detection);
+  }
+  if (out.relocalized) emit(RelocalizationEvent{r.index, r.timestamp, *out.relocalized}, &Observer::on_relocalization);
+  if (out.keyframe && out.live_T_wc)
+    emit(KeyframeEvent{out.keyframe_id, r.index, r.timestamp, *out.live_T_wc}, &Observer::on_keyframe);
+  emit(r, &Observer::on_frame);
+  deliver_queued();
+  return r;
+}
+
+void Slam::deliver_queued() {
+  for (const Relay::Record& rec : relay_->take()) {
+    if (const auto* m = std::get_if<slam::KeyframeMapped>(&rec)) emit(*m, &Observer::on_keyframe_mapped);
+    else if (const auto* s = std::get_if<slam::LoopSearch>(&rec)) emit(*s, &Observer::on_loop_search);
+    else if (const auto* l = std::get_if<slam::LoopRecord>(&rec)) emit(*l, &Observer::on_loop);
+  }
+}
+
+void Slam::finish() {
+  if (finished_) return;
+  finished_ = true;
+  if (system_) system_->finish();
+  deliver_queued();
+}
+
+Trajectory Slam::camera_trajectory() const { return system_ ? system_->camera_trajectory() : Trajectory{}; }
+
+Trajectory Slam::keyframe_trajectory() const { return system_ ? system_->keyframe_trajectory() : Trajectory{}; }
+
+const slam::Map& Slam::map() const { return system_ ? system_->map() : empty_map_; }
+
+SlamSummary Slam::summary() const {
+  SlamSummary s;
+  s.frames = frames_;
+  s.tracked = tracked_;
+  if (system_) {
+    s.keyframes = system_->map().num_keyframes();
+    s.map_points = system_->map().num_map_points();
+    s.segments = system_->tracker().segments();
+    s.relocalizations = system_->tracker().relocalizations();
+  }
+  s.detector = masker_ ? masker_->detector_name() : "none";
+  s.detector_runs = masker_ ? masker_->detector_runs() : 0;
+  s.detector_asynchronous = masker_ && semantic_.asynchronous;
+  return s;
+}
+
+}  // namespace varslam

@@ -1,0 +1,118 @@
+#pragma once
+// varslam::Slam: the whole system of the paper behind one object. Settings -> depth registration -> person
+// detector + depth-aware keypoint filter + extraction mask -> tracking -> local mapping -> loop closing, in
+// deterministic mode (every stage in the caller's thread: same input, same output) or real-time mode (local
+// mapping and the detector on their own threads). Feed it colour + depth + timestamp; it returns the pose and
+// reports everything else to observers (pipeline/events.hpp). It never prints (the stages log through spdlog).
+//
+//   varslam::Slam slam(varslam::load_settings("settings.yaml"));
+//   for (...) { const varslam::FrameResult r = slam.track(bgr, depth16, t); if (r.T_wc) use(*r.T_wc); }
+//   slam.finish();
+//   const varslam::Trajectory traj = slam.camera_trajectory();
+#include <memory>
+#include <mutex>
+#include <span>
+#include <vector>
+
+#include "core/rgbd_frame.hpp"
+#include "core/trajectory.hpp"
+#include "io/settings.hpp"
+#include "pipeline/events.hpp"
+#include "semantic/detector.hpp"
+#include "semantic/detector_settings.hpp"
+#include "slam/config.hpp"
+#include "slam/system.hpp"
+
+namespace varslam {
+
+using slam::RunMode;
+
+namespace semantic {
+class DynamicKeypointMasker;
+}
+
+struct SlamOptions {
+  RunMode mode = RunMode::Deterministic;
+  /// A person detector of the caller's own, used instead of the one `semantic.detector` names.
+  std::shared_ptr<semantic::Detector> detector;
+};
+
+/// Facts about the whole run so far (on request).
+struct SlamSummary {
+  std::size_t frames = 0, tracked = 0, keyframes = 0, map_points = 0;
+  int segments = 0, relocalizations = 0;
+  std::string detector;        // "none" without the person filter
+  long detector_runs = 0;
+  bool detector_asynchronous = false;
+};
+
+class Slam {
+ public:
+  /// Throws ConfigError for bad settings and InputError when the detector's model cannot be loaded.
+  explicit Slam(const Settings& settings, SlamOptions options = {});
+  ~Slam();  // stops the worker threads (finish() first to keep the map complete)
+  Slam(const Slam&) = delete;
+  Slam& operator=(const Slam&) = delete;
+
+  /// Observers get every event from now on, in the order added. Not owned: each must outlive the pipeline or be
+  /// removed first.
+  void add_observer(Observer& observer);
+  void remove_observer(Observer& observer);
+
+  /// Optional, before the first frame: decide depth registration (`depth.registration: auto`) on these frames
+  /// (about 10 spread over the sequence is what the CLI uses). Without it, the first tracked frame decides alone.
+  void calibrate_depth(std::span<const RgbdFrame> samples);
+  /// True when calibrate_depth() looks at its samples (`depth.registration: auto` and no depth.camera_* given).
+  bool wants_depth_samples() const { return cfg_.tracking.estimate_registration && !cfg_.tracking.depth_rig; }
+  /// What a loader thread may apply to each frame before track() (thread-safe; valid after calibrate_depth()):
+  /// warps unregistered depth into the colour camera. track() does it itself for frames that did not get it.
+  std::function<void(RgbdFrame&)> frame_preparation() const;
+
+  /// Tracks one frame. `bgr`: CV_8UC3 (or CV_8UC1 gray); `depth`: CV_16UC1 raw (divided by depth.factor) or
+  /// CV_32FC1 metres, 0 = no depth; both of the camera's size. `boxes`: the people in this image from the caller's
+  /// own detector (the person filter then uses them as they are).
+  FrameResult track(const cv::Mat& bgr, const cv::Mat& depth, double timestamp,
+                    const std::optional<Detections>& boxes = std::nullopt);
+  /// The same for a decoded frame (dataset readers: depth already in metres).
+  FrameResult track(const RgbdFrame& frame, const std::optional<Detections>& boxes = std::nullopt);
+
+  /// Finishes local mapping and loop closing so the map and trajectories are final; rethrows an error a worker
+  /// thread stopped on. Later track() calls are an error.
+  void finish();
+
+  /// Camera-to-world pose of every tracked frame, after every correction so far (BA, loops).
+  Trajectory camera_trajectory() const;
+  /// Each pose as tracking gave it (what a live user got).
+  const Trajectory& live_trajectory() const { return live_; }
+  Trajectory keyframe_trajectory() const;
+  const slam::Map& map() const;
+  SlamSummary summary() const;
+
+  const Settings& settings() const { return settings_; }  // camera = the colour camera after registration
+  const slam::SlamConfig& config() const { return cfg_; }
+  RunMode mode() const { return options_.mode; }
+
+ private:
+  class Relay;  // takes the stages' records (any thread) and queues them for the observers
+  void start(std::span<const RgbdFrame> samples);
+  void install_person_filter();
+  void deliver_queued();
+  template <typename Event, typename Fn>
+  void emit(const Event& e, Fn fn);
+
+  Settings settings_;
+  slam::SlamConfig cfg_;
+  SlamOptions options_;
+  semantic::SemanticSettings semantic_;
+  std::vector<Observer*> observers_;
+  std::unique_ptr<Relay> relay_;
+  std::unique_ptr<semantic::DynamicKeypointMasker> masker_;
+  std::optional<DetectionEvent> detection_;  // of the frame being tracked, handed out after it
+  std::unique_ptr<slam::System> system_;     // built by start(), once the colour camera is known
+  const slam::Map empty_map_;               // what map() shows before the first frame
+  Trajectory live_;
+  std::size_t frames_ = 0, tracked_ = 0;
+  bool finished_ = false;
+};
+
+}  // namespace varslam

@@ -1,0 +1,45 @@
+#pragma once
+// Runs the pipeline over a dataset and writes what a user opens afterwards: TUM trajectories, the map as PLY,
+// metrics.json (with the ATE and RPE when ground truth exists). The dataset loop, pacing and the file writers;
+// everything SLAM is varslam::Slam.
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <set>
+#include <vector>
+
+#include "io/dataset.hpp"
+#include "io/settings.hpp"
+#include "pipeline/slam.hpp"
+
+namespace varslam::run {
+
+struct RunOptions {
+  RunMode mode = RunMode::Deterministic;
+  bool pace = false;           // real-time mode: feed frames at the dataset's frame rate (else as fast as possible)
+  std::size_t first = 0;       // first frame index
+  std::size_t max_frames = SIZE_MAX;
+  bool progress = true;        // progress line on stderr
+  std::optional<std::filesystem::path> groundtruth;  // overrides the dataset's groundtruth.txt
+  std::set<std::size_t> debug_frames;  // frame indices for which the semantic filter's stages are drawn
+  std::vector<Observer*> observers;    // more observers of the pipeline (e.g. a live viewer)
+};
+
+struct RunSummary {
+  std::size_t frames = 0, tracked = 0, lost = 0, keyframes = 0, map_points = 0;
+  int segments = 0;
+  double wall_seconds = 0, fps = 0;
+  std::optional<double> ate_rmse, ate_max;
+  nlohmann::json metrics;
+  std::filesystem::path out_dir;
+};
+
+/// Runs SLAM with `settings` (the `semantic:` section decides whether a detector filters known movers; in
+/// deterministic mode detection is waited for, so results do not depend on timing).
+RunSummary run_slam(const Dataset& dataset, const Settings& settings, const RunOptions& options,
+                    const std::filesystem::path& out_dir);
+
+/// Writes the map's points as an ASCII PLY (x y z).
+void write_map_ply(const slam::Map& map, const std::filesystem::path& file);
+
+}  // namespace varslam::run

@@ -1,0 +1,122 @@
+#include "run/metrics_recorder.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace varslam::run {
+namespace {
+
+nlohmann::json timing_json(const std::vector<double>& v) {
+  const auto [med, p95] = median_p95(v);
+  return {{"median_ms", med}, {"p95_ms", p95}, {"count", v.size()}};
+}
+
+nlohmann::json count_json(const std::vector<double>& v) {
+  const auto [med, p95] = median_p95(v);
+  return {{"median", med}, {"p95", p95}, {"frames", v.size()}};
+}
+
+}  // namespace
+
+std::pair<double, double> median_p95(std::vector<double> v) {
+  if (v.empty()) return {0.0, 0.0};
+  std::sort(v.begin(), v.end());
+  const double med = v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+  const std::size_t k = static_cast<std::size_t>(std::ceil(0.95 * static_cast<double>(v.size()))) - 1;
+  return {med, v[std::min(k, v.size() - 1)]};
+}
+
+void MetricsRecorder::on_depth_registration(const DepthRegistrationEvent& e) {
+  if (e.mode != "auto") {
+    registration_ = {{"mode", e.mode}};
+    return;
+  }
+  registration_ = {{"mode", "auto"}, {"found", e.found}, {"scale", e.scale}, {"du", e.du}, {"dv", e.dv},
+                   {"score", e.score}, {"identity_score", e.identity_score}, {"frames", e.frames}, {"ms", e.ms}};
+  if (e.colour_camera)
+    registration_["colour_camera"] = {{"fx", e.colour_camera->fx}, {"fy", e.colour_camera->fy},
+                                      {"cx", e.colour_camera->cx}, {"cy", e.colour_camera->cy}};
+}
+
+void MetricsRecorder::on_frame(const FrameResult& f) {
+  stamps_.push_back(f.timestamp);
+  tracked_ += f.state == TrackState::Ok;
+  extract_.push_back(f.timings.extract_ms);
+  filter_.push_back(f.timings.filter_ms);
+  match_.push_back(f.timings.match_ms);
+  pose_.push_back(f.timings.pose_ms);
+  track_.push_back(f.timings.track_ms);
+  edge_rejected_.push_back(f.depth_edge_rejected);
+  keypoints_.push_back(f.keypoints);
+}
+
+void MetricsRecorder::on_detection(const DetectionEvent& d) {
+  semantic_ran_ = true;
+  if (d.have_detections) {
+    box_age_ms_.push_back(1000.0 * d.box_age_s);
+    detector_latency_ms_.push_back(1000.0 * d.detector_latency_s);
+  } else {
+    ++frames_without_boxes_;
+  }
+  dropped_.push_back(d.stats.dropped);
+}
+
+void MetricsRecorder::on_keyframe_mapped(const slam::KeyframeMapped& m) {
+  keyframe_ms_.push_back(m.ms);
+  triangulated_ += m.triangulated_points;
+  culled_points_ += m.culled_points;
+  culled_keyframes_ += m.culled_keyframes;
+  if (!m.ba) return;
+  const slam::BaRecord& b = *m.ba;
+  ba_ms_.push_back(b.ms);
+  ba_.push_back({{"keyframe", b.keyframe_id}, {"timestamp", b.timestamp}, {"keyframes", b.keyframes},
+                 {"fixed_keyframes", b.fixed_keyframes}, {"points", b.points}, {"observations", b.observations},
+                 {"outliers", b.outliers}, {"alpha_per_iteration", b.alpha_per_iteration},
+                 {"final_alpha", b.final_alpha}, {"fitted_alpha", b.fitted_alpha}, {"refine_alpha", b.refine_alpha},
+                 {"ms", b.ms}});
+}
+
+nlohmann::json MetricsRecorder::metrics(const Slam& slam) const {
+  const SlamSummary s = slam.summary();
+  nlohmann::json m;
+  m["mode"] = slam.mode() == RunMode::Deterministic ? "deterministic" : "realtime";
+  m["frames"] = frames();
+  m["tracked_frames"] = tracked_;
+  m["lost_frames"] = frames() - tracked_;
+  m["tracked_share"] = frames() ? static_cast<double>(tracked_) / static_cast<double>(frames()) : 0.0;
+  m["map_segments"] = s.segments;
+  m["relocalizations"] = s.relocalizations;
+  m["keyframes"] = s.keyframes;
+  m["map_points"] = s.map_points;
+  m["triangulated_points"] = triangulated_;
+  m["culled_points"] = culled_points_;
+  m["culled_keyframes"] = culled_keyframes_;
+  m["depth_registration"] = registration_;
+  m["kernels"] = {{"tracking", slam::kernel_name(slam.config().tracking.kernel.type)},
+                  {"mapping", slam::kernel_name(slam.config().mapping.kernel.type)}};
+  m["timings"] = {{"load", timing_json(load_ms_)},       {"extract", timing_json(extract_)},
+                  {"filter", timing_json(filter_)},      {"match", timing_json(match_)},
+                  {"pose_optimization", timing_json(pose_)}, {"tracking", timing_json(track_)},
+                  {"keyframe_processing", timing_json(keyframe_ms_)}, {"local_ba", timing_json(ba_ms_)},
+                  {"loop_detection", timing_json(loop_search_ms_)}};
+  m["local_ba"] = ba_;
+  nlohmann::json loops = nlohmann::json::array();
+  for (const slam::LoopRecord& l : loops_)
+    loops.push_back({{"keyframe", l.query_keyframe}, {"loop_keyframe", l.loop_keyframe}, {"timestamp", l.timestamp},
+                     {"place_score", l.score}, {"ransac_inliers", l.ransac_inliers}, {"inliers", l.inliers},
+                     {"fused_points", l.fused_points}, {"correction_m", l.correction_m},
+                     {"correction_deg", l.correction_deg}, {"pose_graph_ms", l.pose_graph_ms},
+                     {"global_ba_ms", l.global_ba_ms}, {"total_ms", l.total_ms}});
+  m["loops"] = loops;
+  m["keypoints_per_frame"] = count_json(keypoints_);
+  m["depth_edge_rejected_per_frame"] = count_json(edge_rejected_);
+  if (s.detector != "none" || semantic_ran_) {
+    m["semantic"] = {{"detector", s.detector}, {"detector_runs", s.detector_runs},
+                     {"asynchronous", s.detector_asynchronous}, {"frames_without_boxes", frames_without_boxes_},
+                     {"box_age", timing_json(box_age_ms_)}, {"detector_latency", timing_json(detector_latency_ms_)},
+                     {"dropped_keypoints_per_frame", count_json(dropped_)}};
+  }
+  return m;
+}
+
+}  // namespace varslam::run

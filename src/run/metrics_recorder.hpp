@@ -1,0 +1,46 @@
+#pragma once
+// The observer behind metrics.json: per-stage timings (median, p95), keypoint counts, the alpha of every Local
+// BA, each closed loop, the person detector's latency and box age, depth registration. Adding a metric means
+// recording it here from an event and writing it in metrics().
+#include <nlohmann/json.hpp>
+#include <vector>
+
+#include "pipeline/slam.hpp"
+
+namespace varslam::run {
+
+/// Median and 95th percentile (nearest rank) of a sample, {0, 0} when empty.
+std::pair<double, double> median_p95(std::vector<double> v);
+
+class MetricsRecorder final : public Observer {
+ public:
+  /// Time the dataset loop waited for the frame (decoding runs ahead on its own thread).
+  void add_load_ms(double ms) { load_ms_.push_back(ms); }
+
+  void on_depth_registration(const DepthRegistrationEvent& e) override;
+  void on_frame(const FrameResult& f) override;
+  void on_detection(const DetectionEvent& d) override;
+  void on_keyframe_mapped(const slam::KeyframeMapped& m) override;
+  void on_loop_search(const slam::LoopSearch& s) override { loop_search_ms_.push_back(s.ms); }
+  void on_loop(const slam::LoopRecord& l) override { loops_.push_back(l); }
+
+  /// The metrics of the run so far; `slam` gives the facts kept by the pipeline (map size, segments, kernels).
+  nlohmann::json metrics(const Slam& slam) const;
+  const std::vector<double>& frame_timestamps() const { return stamps_; }
+  std::size_t frames() const { return stamps_.size(); }
+  std::size_t tracked() const { return tracked_; }
+
+ private:
+  nlohmann::json registration_ = {{"mode", "off"}};
+  std::vector<double> stamps_, load_ms_, extract_, filter_, match_, pose_, track_, edge_rejected_, keypoints_;
+  std::size_t tracked_ = 0;
+  std::vector<double> keyframe_ms_, ba_ms_, loop_search_ms_;
+  nlohmann::json ba_ = nlohmann::json::array();
+  int triangulated_ = 0, culled_points_ = 0, culled_keyframes_ = 0;
+  std::vector<slam::LoopRecord> loops_;
+  bool semantic_ran_ = false;
+  long frames_without_boxes_ = 0;
+  std::vector<double> box_age_ms_, detector_latency_ms_, dropped_;
+};
+
+}  // namespace varslam::run

@@ -1,0 +1,40 @@
+// slam::System across threads: an exception on the mapping thread reaches the caller with its message.
+#include "slam/system.hpp"
+
+#include <gtest/gtest.h>
+
+#include <stdexcept>
+
+#include "io/dataset.hpp"
+#include "slam/e2e_support.hpp"
+
+namespace varslam::slam {
+namespace {
+
+TEST(System, MappingThreadErrorReachesTheCaller) {
+  synth::SynthConfig sc;
+  sc.scenario = "static";
+  sc.seconds = 4.0;
+  sc.seed = 7;
+  const auto seq = e2e::cached_sequence("static_seq", sc);  // end_to_end_test's: its runs make Local BAs
+  const Settings settings = settings_for_dataset(seq, std::nullopt);
+  SlamConfig cfg = slam_config_from(settings);
+  auto ds = open_dataset(seq, settings);
+  std::string message;
+  int local_bas = 0;
+  cfg.mapping.ba_observer = [&local_bas](const PinholeCamera&, const optim::BaProblem&, const optim::BaConfig&) {
+    if (++local_bas == 2) throw std::runtime_error("local BA exploded");
+  };
+  try {
+    System system(cfg, settings.camera, settings.close_depth_m(), RunMode::RealTime);
+    for (std::size_t i = 0; i < ds->size(); ++i) system.process(ds->load(i));
+    system.finish();
+  } catch (const std::runtime_error& e) {
+    message = e.what();
+  }
+  EXPECT_EQ(message, "local BA exploded");
+  EXPECT_EQ(local_bas, 2);  // mapping stopped at the error
+}
+
+}  // namespace
+}  // namespace varslam::slam
