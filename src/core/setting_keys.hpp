@@ -171,8 +171,8 @@ inline constexpr KeySpec kKeys[] = {
     detail::integer("relocalization.min_inliers", 30, 3, 100000, "pose inliers against the candidate keyframe"),
 
     // semantic: the person detector and the depth-aware keypoint filter.
-    detail::choice("semantic.detector", "none", "yolo|boxes|hog|none", "person detector: yolo (OpenCV dnn), boxes (a boxes file), hog, none (no person filter)"),
-    detail::textual(KeyType::Text, "semantic.model", "yolo-fastest-1.1-xl", "YOLO preset (yolo-fastest-1.1-xl, yolo-fastest-1.1_body), looked up in model_dir, $VARSLAM_MODELS, ./models, ../shared/models"),
+    detail::choice("semantic.detector", "auto", "auto|yolo|boxes|hog|none", "person detector: auto (yolo when its model is found, else none, said once), yolo (OpenCV dnn), boxes (a boxes file), hog, none (no person filter)"),
+    detail::textual(KeyType::Text, "semantic.model", "yolo-fastest-1.1-xl", "YOLO preset (yolo-fastest-1.1-xl, yolo-fastest-1.1_body), looked up in model_dir, $VARSLAM_MODELS, ./models, ../shared/models, <install>/share/varslam/models"),
     detail::textual(KeyType::Path, "semantic.model_dir", "", "folder searched first for the model files"),
     detail::textual(KeyType::Path, "semantic.model_cfg", "", "Darknet cfg (with model_weights; instead of a preset)"),
     detail::textual(KeyType::Path, "semantic.model_weights", "", "Darknet weights or an ONNX file (instead of a preset)"),
@@ -183,7 +183,7 @@ inline constexpr KeySpec kKeys[] = {
     detail::textual(KeyType::TextList, "semantic.classes", "person", "labels kept (after aliasing)"),
     detail::textual(KeyType::TextMap, "semantic.label_aliases", "body:person", "labels renamed before the class test"),
     detail::integer("semantic.num_threads", 1, 0, 256, "OpenCV threads of the detector (0 = OpenCV's choice)"),
-    detail::textual(KeyType::Path, "semantic.boxes_file", "", "boxes file of detector: boxes (one line per box: timestamp label score x y w h)"),
+    detail::textual(KeyType::Path, "semantic.boxes_file", "boxes.txt", "boxes file of detector: boxes (one line per box: timestamp label score x y w h); relative: to the dataset folder, then to the settings file"),
     detail::real("semantic.boxes_max_dt", 0.02, 0.0, 10.0, "largest timestamp gap (s) to still use a frame's boxes from the boxes file"),
     detail::real("semantic.box_enlarge", 0.1, 0.0, 2.0, "fraction of width and height added on each side of a box", {}, ")"),
     detail::positive("semantic.depth_band_m", 0.5, 10.0, "keypoints within this distance (m) of the person depth are dropped"),

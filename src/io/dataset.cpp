@@ -167,9 +167,10 @@ std::unique_ptr<Dataset> open_dataset(const std::filesystem::path& dir, const Se
 }
 
 Settings settings_for_dataset(const std::filesystem::path& dir, const std::optional<std::filesystem::path>& file) {
-  if (file) return load_settings(*file);
-  if (fs::exists(dir / "settings.yaml")) return load_settings(dir / "settings.yaml");
-  Settings s = default_settings();
+  Settings s = file ? load_settings(*file)
+                    : fs::exists(dir / "settings.yaml") ? load_settings(dir / "settings.yaml") : default_settings();
+  s.dataset_dir = dir;
+  if (!s.source.empty()) return s;
   if (fs::is_directory(dir) && &detect_layout(dir) == &kOpenLoris) s.depth_factor = 1000.0;
   spdlog::warn("{}: no settings file given and no settings.yaml in the folder; using default settings (TUM fr1 "
                "camera fx {} fy {} cx {} cy {}, {}x{}, depth factor {})",

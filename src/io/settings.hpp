@@ -27,6 +27,7 @@ struct Settings {
   OrbSettings orb;
   YAML::Node root;                 // the whole document, for stage sections (tracking, mapping, robust, ...)
   std::filesystem::path source;    // file it came from; empty for defaults
+  std::filesystem::path dataset_dir;  // the dataset these settings run on, when known (relative data files)
   std::map<std::string, std::string> overrides;  // dotted key -> the `--set 'k=v'` that gave it (for messages)
 
   /// Close/far threshold in metres (ThDepth * baseline).

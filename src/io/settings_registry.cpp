@@ -399,7 +399,9 @@ void apply_setting_overrides(Settings& settings, const std::vector<std::string>&
     settings.overrides[dotted] = loc;
   }
   // Camera, depth and ORB fields were read when the document was loaded: read them again from the edited one.
+  const std::filesystem::path dataset_dir = settings.dataset_dir;
   settings = settings_from_yaml(settings.root, settings.source, settings.overrides);
+  settings.dataset_dir = dataset_dir;
 }
 
 std::string nearest_key(std::string_view name, bool section_only) {

@@ -60,6 +60,9 @@ std::vector<fs::path> model_search_dirs(const fs::path& model_dir) {
   if (const char* env = std::getenv("VARSLAM_MODELS"); env && *env) candidates.emplace_back(env);
   candidates.emplace_back("models");
   candidates.emplace_back("../shared/models");
+  std::error_code exe_ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", exe_ec);
+  if (!exe_ec) candidates.push_back(exe.parent_path().parent_path() / "share" / "varslam" / "models");
   std::vector<fs::path> out;
   std::error_code ec;
   for (const auto& c : candidates)

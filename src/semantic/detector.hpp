@@ -14,7 +14,7 @@
 namespace varslam::semantic {
 
 struct DetectorConfig {
-  std::string source{setting_keys::text_default("semantic.detector")};  // yolo | boxes | hog | none
+  std::string source = "none";  // yolo | boxes | hog | none (semantic_settings() resolves the setting's auto)
   // yolo: Darknet cfg + weights, or an .onnx file as weights (cfg unused). Empty cfg and weights mean the preset
   // `model` (<model>.cfg + <model>.weights). A relative path that does not exist as given is looked up in
   // model_dir and the default model directories (see model_search_dirs). Empty names_file: <weights stem>.names,
@@ -49,7 +49,8 @@ class Detector {
 std::unique_ptr<Detector> make_detector(const DetectorConfig& cfg);
 
 /// Where relative model files are looked up, in order: cfg.model_dir (if set), env VARSLAM_MODELS, ./models,
-/// ../shared/models (relative to the current directory). Only existing directories are returned.
+/// ../shared/models (relative to the current directory), then <install prefix>/share/varslam/models (next to the
+/// running program's bin/). Only existing directories are returned.
 std::vector<std::filesystem::path> model_search_dirs(const std::filesystem::path& model_dir = {});
 
 /// The YOLO files make_detector() would load: cfg (empty for .onnx), weights, names. Throws InputError (naming

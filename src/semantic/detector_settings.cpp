@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <spdlog/spdlog.h>
+
 #include "core/error.hpp"
 #include "io/settings_registry.hpp"
 
@@ -10,14 +12,36 @@ namespace {
 namespace fs = std::filesystem;
 
 // Relative paths are relative to the settings file, if that makes them exist; else kept for the model search.
-fs::path read_path(const Settings& s, const char* key) {
+// `dataset_first`: a data file of the dataset (boxes.txt) is looked for in the dataset's folder first.
+fs::path read_path(const Settings& s, const char* key, bool dataset_first = false) {
   const std::string text = setting<std::string>(s, key);
   if (text.empty()) return {};
-  fs::path p(text);
+  const fs::path p(text);
+  if (!p.is_relative()) return p;
   std::error_code ec;
-  const fs::path base = s.source.empty() ? fs::path() : s.source.parent_path();
-  if (p.is_relative() && !base.empty() && fs::exists(base / p, ec)) p = base / p;
-  return p;
+  std::vector<fs::path> bases;
+  if (dataset_first && !s.dataset_dir.empty()) bases.push_back(s.dataset_dir);
+  if (!s.source.empty()) bases.push_back(s.source.parent_path());
+  for (const fs::path& base : bases)
+    if (fs::exists(base / p, ec)) return base / p;
+  return dataset_first && !s.dataset_dir.empty() ? s.dataset_dir / p : p;
+}
+
+// `auto`: the paper's system wherever it can be, YOLO when its model files are there, else no person filter.
+std::string resolve_detector(const std::string& source, const DetectorConfig& d) {
+  if (source != "auto") return source;
+  DetectorConfig yolo = d;
+  yolo.source = "yolo";
+  try {
+    resolve_yolo_files(yolo);
+    return "yolo";
+  } catch (const InputError&) {
+    spdlog::info("no person filter: the YOLO model '{}' is not in semantic.model_dir, $VARSLAM_MODELS, ./models or "
+                 "<install>/share/varslam/models (README, 'Person detector models', says where to get it); "
+                 "semantic.detector: none to run without it quietly",
+                 d.model);
+    return "none";
+  }
 }
 
 float real(const Settings& s, const char* key) { return static_cast<float>(setting<double>(s, key)); }
@@ -27,12 +51,12 @@ float real(const Settings& s, const char* key) { return static_cast<float>(setti
 SemanticSettings semantic_settings(const Settings& s) {
   SemanticSettings out;
   DetectorConfig& d = out.detector;
-  d.source = setting<std::string>(s, "semantic.detector");
   d.model = setting<std::string>(s, "semantic.model");
   d.model_dir = read_path(s, "semantic.model_dir");
   d.model_cfg = read_path(s, "semantic.model_cfg");
   d.model_weights = read_path(s, "semantic.model_weights");
   d.names_file = read_path(s, "semantic.names_file");
+  d.source = resolve_detector(setting<std::string>(s, "semantic.detector"), d);
   d.input_size = setting<int>(s, "semantic.input_size");
   if (d.input_size % 32 != 0)
     throw ConfigError(fmt::format("{}: key 'semantic.input_size' must be a multiple of 32, got {}",
@@ -42,7 +66,7 @@ SemanticSettings semantic_settings(const Settings& s) {
   d.classes = setting<std::vector<std::string>>(s, "semantic.classes");
   d.label_aliases = setting<std::map<std::string, std::string>>(s, "semantic.label_aliases");
   d.num_threads = setting<int>(s, "semantic.num_threads");
-  d.boxes_file = read_path(s, "semantic.boxes_file");
+  d.boxes_file = read_path(s, "semantic.boxes_file", /*dataset_first=*/true);
   d.boxes_max_dt = setting<double>(s, "semantic.boxes_max_dt");
 
   FilterConfig& f = out.filter;

@@ -83,9 +83,16 @@ Images read_images(const fs::path& seq, const Settings& settings, std::size_t n)
   return im;
 }
 
+// The dataset's settings with the detector named (its default, auto, depends on whether a model is installed).
+Settings settings_without_detector(const fs::path& seq) {
+  Settings s = settings_for_dataset(seq, std::nullopt);
+  apply_setting_overrides(s, {"semantic.detector=none"});
+  return s;
+}
+
 TEST(Pipeline, FedImagesGiveTheDatasetRunsTrajectoryAndEveryEvent) {
   const fs::path seq = walking_sequence();
-  const Settings settings = settings_for_dataset(seq, std::nullopt);
+  const Settings settings = settings_without_detector(seq);
   const fs::path out = out_dir("images");
   run::RunOptions ro;
   ro.progress = false;
@@ -116,14 +123,14 @@ TEST(Pipeline, FedImagesGiveTheDatasetRunsTrajectoryAndEveryEvent) {
   EXPECT_EQ(tally.mapped, tally.keyframe_events);  // deterministic: every keyframe mapped before the next frame
   EXPECT_GT(tally.local_bas, 0);
   EXPECT_TRUE(tally.alphas_recorded);
-  EXPECT_EQ(tally.detections, 0);  // the dataset's settings name no detector
+  EXPECT_EQ(tally.detections, 0);
   EXPECT_EQ(slam.summary().detector, "none");
   EXPECT_THROW(slam.track(im.bgr[0], im.depth[0], 99.0), std::logic_error);
 }
 
 TEST(Pipeline, CallersBoxesSwitchThePersonFilterOn) {
   const fs::path seq = walking_sequence();
-  const Settings settings = settings_for_dataset(seq, std::nullopt);
+  const Settings settings = settings_without_detector(seq);
   const BoxesByTime boxes = read_boxes_file(seq / "boxes.txt");
   const Images im = read_images(seq, settings, 20);
   Slam slam(settings);
@@ -137,7 +144,7 @@ TEST(Pipeline, CallersBoxesSwitchThePersonFilterOn) {
 
   // The same boxes through the settings' boxes file give the same trajectory.
   Settings with_file = settings;
-  apply_setting_overrides(with_file, {"semantic.detector=boxes", "semantic.boxes_file=" + (seq / "boxes.txt").string()});
+  apply_setting_overrides(with_file, {"semantic.detector=boxes"});  // the dataset's boxes.txt by default
   Slam from_file(with_file);
   for (std::size_t i = 0; i < im.bgr.size(); ++i) from_file.track(im.bgr[i], im.depth[i], im.stamps[i]);
   from_file.finish();
@@ -148,7 +155,9 @@ TEST(Pipeline, CallersBoxesSwitchThePersonFilterOn) {
 }
 
 TEST(Pipeline, ImagesOfTheWrongSizeOrTypeAreInputErrors) {
-  Slam slam(default_settings());
+  Settings settings = default_settings();
+  apply_setting_overrides(settings, {"semantic.detector=none"});
+  Slam slam(settings);
   const cv::Mat bgr(480, 640, CV_8UC3, cv::Scalar::all(100)), depth(480, 640, CV_16UC1, cv::Scalar::all(5000));
   EXPECT_THROW(slam.track(cv::Mat(240, 320, CV_8UC3), depth, 0.0), InputError);
   EXPECT_THROW(slam.track(bgr, cv::Mat(480, 640, CV_8UC2), 0.0), InputError);
