@@ -132,6 +132,11 @@ inline constexpr KeySpec kKeys[] = {
     detail::integer("tracking.lost_frames_before_reinit", 3, 1, 1000000, "failed recoveries before a new map segment starts"),
     detail::integer("tracking.vo_points", 100, 0, 100000, "temporary depth points kept in the last frame (RGB-D visual odometry)"),
     detail::integer("tracking.close_keyframe_gap", 5, 1, 1000000, "frames between keyframes triggered by untracked close points"),
+    detail::real("tracking.keyframe_inlier_ratio", 0.75, 0.0, 1.0, "a frame tracking fewer inliers than this share of its reference keyframe's points may become a keyframe"),
+    detail::real("tracking.keyframe_urgent_ratio", 0.25, 0.0, 1.0, "below this share it becomes one even while the last keyframe is recent and mapping is busy"),
+    detail::integer("tracking.keyframe_min_inliers", 15, 0, 100000, "a keyframe needs more inliers than this"),
+    detail::integer("tracking.close_tracked_max", 100, 0, 100000, "with fewer close points tracked than this ..."),
+    detail::integer("tracking.close_untracked_min", 70, 0, 100000, "... and more close points untracked than this, the frame adds structure: a keyframe (every close_keyframe_gap frames at most)"),
 
     // mapping: local mapping and Local BA.
     detail::choice("mapping.kernel", "barron-adaptive", "huber|barron-fixed|barron-adaptive|none", "robust kernel of Local BA (paper: barron-adaptive; huber = ORB-SLAM3)"),
@@ -147,6 +152,7 @@ inline constexpr KeySpec kKeys[] = {
     detail::integer("mapping.triangulation_neighbours", 10, 1, 1000, "covisible keyframes searched for new points"),
     detail::integer("mapping.max_ba_keyframes", 20, 2, 10000, "keyframes optimised per Local BA (the most covisible); the others observing stay fixed"),
     detail::real("mapping.keyframe_redundancy", 0.9, 0.0, 1.0, "share of a keyframe's points seen by 3 other keyframes that makes it redundant", {}, "("),
+    detail::real("mapping.min_found_ratio", 0.25, 0.0, 1.0, "new points found in fewer than this share of the frames that should see them are culled"),
     detail::flag("mapping.cull_keyframes", true, "remove redundant keyframes"),
 
     // loop: place recognition and loop correction.

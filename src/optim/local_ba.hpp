@@ -31,11 +31,8 @@ struct BaProblem {
 /// BarronAdaptive: what the first outer iteration does.
 enum class AlphaStart {
   FitInitialState,  // the paper: fit alpha on the initial state, then solve
-  // First solve with kernel.barron_alpha, fits from its result on. Measured (bench window, callgrind): 1.59x
-  // Huber's instructions instead of 2.3x from a cold start (the initial fit picks alpha = -10, slow to
-  // converge), but the moving-object test loses most of its margin over Huber (0.165 m vs 0.077 m mean
-  // keyframe error, Huber 0.170 m, 6 seeds): the strongly robust first solve is what keeps the mover out.
-  // A floor of 0 on the first fit behaves the same way. Hence not the default.
+  // First solve with kernel.barron_alpha, fits from its result on: cheaper, but the strongly robust first
+  // solve is what keeps a mover out (BENCHMARKS.md, "Why the defaults"). Hence not the default.
   SolveFirst,
 };
 

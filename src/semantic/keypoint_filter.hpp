@@ -21,12 +21,11 @@ struct FilterConfig {
   float peak_fraction = static_cast<float>(setting_keys::real_default("semantic.peak_fraction"));
   int sample_step = setting_keys::int_default("semantic.sample_step");         // depth samples every n-th pixel inside a box (cost vs. accuracy)
   // Background keypoints closer than this (pixels at pyramid level 0, scaled with the keypoint's size) to a pixel
-  // at the person's depth are dropped too: a corner on the silhouette moves with the person. 0 = off (default:
-  // on the synthetic walking sequences 5 px removed 95 % of such keypoints but did not lower the ATE).
+  // at the person's depth are dropped too: a corner on the silhouette moves with the person. 0 = off.
   float silhouette_margin_px = static_cast<float>(setting_keys::real_default("semantic.silhouette_margin_px"));
   // Overlapping boxes: a second person depth from the part of the box no other box covers, when that part holds at
   // least this share of the box's depth samples (the nearer person must not capture the farther one's estimate).
-  // 1 = off (default, for the same reason as the margin; 0.2 removed most leaks between overlapping people).
+  // 1 = off.
   float min_exclusive_share = static_cast<float>(setting_keys::real_default("semantic.min_exclusive_share"));
 };
 

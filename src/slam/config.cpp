@@ -87,6 +87,11 @@ SlamConfig slam_config_from(const Settings& s) {
   t.vo_points = setting<int>(s, "tracking.vo_points");
   t.close_keyframe_gap = setting<int>(s, "tracking.close_keyframe_gap");
   t.lost_frames_before_reinit = setting<int>(s, "tracking.lost_frames_before_reinit");
+  t.keyframe_inlier_ratio = setting<double>(s, "tracking.keyframe_inlier_ratio");
+  t.keyframe_urgent_ratio = setting<double>(s, "tracking.keyframe_urgent_ratio");
+  t.keyframe_min_inliers = setting<int>(s, "tracking.keyframe_min_inliers");
+  t.close_tracked_max = setting<int>(s, "tracking.close_tracked_max");
+  t.close_untracked_min = setting<int>(s, "tracking.close_untracked_min");
 
   MappingConfig& m = c.mapping;
   m.kernel = read_kernel(s, "mapping");
@@ -96,6 +101,7 @@ SlamConfig slam_config_from(const Settings& s) {
   m.triangulation_neighbours = setting<int>(s, "mapping.triangulation_neighbours");
   m.max_ba_keyframes = setting<int>(s, "mapping.max_ba_keyframes");
   m.keyframe_redundancy = setting<double>(s, "mapping.keyframe_redundancy");
+  m.min_found_ratio = setting<double>(s, "mapping.min_found_ratio");
   m.cull_keyframes = setting<bool>(s, "mapping.cull_keyframes");
 
   LoopConfig& l = c.loop;

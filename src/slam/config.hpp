@@ -48,49 +48,48 @@ inline constexpr optim::KernelConfig kMappingKernelDefaults = [] {
   return k;
 }();
 
+// Each field's meaning, range and default are in the settings registry (core/setting_keys.hpp, docs/settings.md)
+// under the key it is read from (slam_config_from); what is said here is only what the registry cannot say.
 struct TrackingConfig {
-  optim::KernelConfig kernel = kTrackingKernelDefaults;  // pose-only optimisation
-  double motion_radius = setting_keys::real_default("tracking.motion_radius");     // search radius (pixels at level 0) when matching against the last frame
-  int min_matches = setting_keys::int_default("tracking.min_matches");            // motion-model matches needed before optimising
-  double motion_inlier_ratio = setting_keys::real_default("tracking.motion_inlier_ratio");  // fewer motion-model inliers than this share of matches: cross-check
-  int established_found = setting_keys::int_default("tracking.established_found");  // frames a point must have been an inlier in to anchor the first pose round (0: off)
-  // ... and was created at least this many frames ago. A slowly moving box stays consistent with the camera for a
-  // few frames, long enough to be found 3 times; after 10 frames it has moved off. Measured (synthetic benchmark,
-  // 3 s sequences, kernel config): obstructing_box 34.3 -> 24.1 cm, mixed 4.2 -> 3.7, walking 6.5 -> 6.0, static
-  // unchanged; full config mixed 12.2 -> 4.2 but walking 3.0 -> 4.0; kitchen 4.63 -> 5.94 deterministic, equal in
-  // real time (three runs each: 4.76 / 5.73 / 5.78 against 6.16 / 5.58 / 5.67). 0 turns it off.
+  optim::KernelConfig kernel = kTrackingKernelDefaults;  // pose-only optimisation: tracking.kernel, barron_*
+  double motion_radius = setting_keys::real_default("tracking.motion_radius");
+  int min_matches = setting_keys::int_default("tracking.min_matches");
+  double motion_inlier_ratio = setting_keys::real_default("tracking.motion_inlier_ratio");
+  int established_found = setting_keys::int_default("tracking.established_found");
   int established_age = setting_keys::int_default("tracking.established_age");
-  int min_inliers_local_map = setting_keys::int_default("tracking.min_inliers");  // inliers after local-map tracking for the frame to count as tracked
+  int min_inliers_local_map = setting_keys::int_default("tracking.min_inliers");
   int max_local_keyframes = setting_keys::int_default("tracking.max_local_keyframes");
-  int lost_frames_before_reinit = setting_keys::int_default("tracking.lost_frames_before_reinit");  // failed recoveries before a new map segment starts
-  int vo_points = setting_keys::int_default("tracking.vo_points");             // temporary depth points in the last frame (RGB-D visual odometry)
-  int close_keyframe_gap = setting_keys::int_default("tracking.close_keyframe_gap");      // frames between keyframes triggered by untracked close points
-  double depth_edge_ratio = setting_keys::real_default("depth.edge_ratio");   // > 0: drop the depth of keypoints on depth discontinuities (see frame.hpp)
-  // Depth residual in pose optimisation and BA (optim::Observation): 0 = ORB-SLAM3's virtual right coordinate,
-  // which gives depth the noise of a one-pixel stereo match; > 0 = disparity bf/z alone, with sigma 1/weight
-  // pixels at level 0. Kinect-class sensors measure disparity to about 1/10 pixel: ORB-SLAM3's model
-  // under-weights depth, and with people filtered out of a far background a 20 cm sideways jump against a
-  // 2.3 deg turn stayed unresolved. Measured (synthetic benchmark, 144 runs each; weights 0 / 4 / 10 / 20):
-  // full config walking 3.95 / 0.81 / 0.64 / 0.58 cm, mixed 4.15 / 1.06 / 0.72 / 0.82, static 0.30 / 0.28 /
-  // 0.27 / 0.33; real kitchen (deterministic) 5.94 / 4.94 / 4.83 / 4.84.
+  int lost_frames_before_reinit = setting_keys::int_default("tracking.lost_frames_before_reinit");
+  int vo_points = setting_keys::int_default("tracking.vo_points");
+  int close_keyframe_gap = setting_keys::int_default("tracking.close_keyframe_gap");
+  // The keyframe decision (Tracker::need_keyframe), ORB-SLAM's RGB-D rule with its numbers as defaults.
+  double keyframe_inlier_ratio = setting_keys::real_default("tracking.keyframe_inlier_ratio");
+  double keyframe_urgent_ratio = setting_keys::real_default("tracking.keyframe_urgent_ratio");
+  int keyframe_min_inliers = setting_keys::int_default("tracking.keyframe_min_inliers");
+  int close_tracked_max = setting_keys::int_default("tracking.close_tracked_max");
+  int close_untracked_min = setting_keys::int_default("tracking.close_untracked_min");
+  double depth_edge_ratio = setting_keys::real_default("depth.edge_ratio");  // see frame.hpp
+  // Depth residual of pose optimisation and BA (optim::Observation): 0 = ORB-SLAM3's virtual right coordinate,
+  // > 0 = the disparity bf/z alone with sigma 1/weight pixels at level 0.
   double disparity_weight = setting_keys::real_default("depth.disparity_weight");
   // Set when depth comes from a separate, unregistered camera (raw Kinect v1, 7-Scenes): the depth image is
   // warped into the colour camera before keypoint depths are read (keys depth.camera_fx/fy/cx/cy/tx/ty/tz).
   std::optional<DepthCameraRig> depth_rig;
   // Without depth_rig: check on a few frames whether depth is registered to colour, and register it when it
-  // clearly is not (runner.cpp; depth.registration: auto | off).
+  // clearly is not (pipeline/slam.cpp; depth.registration: auto | off).
   bool estimate_registration = setting_keys::text_default("depth.registration") == "auto";
   optim::PoseProblemObserver pose_observer;  // debug/benchmark hook: sees every pose problem (empty: none)
 };
 
 struct MappingConfig {
-  optim::KernelConfig kernel = kMappingKernelDefaults;  // Local BA
+  optim::KernelConfig kernel = kMappingKernelDefaults;  // Local BA: mapping.kernel, barron_*, alpha_*
   int ba_outer_iterations = setting_keys::int_default("mapping.ba_outer_iterations");
   int ba_iterations = setting_keys::int_default("mapping.ba_iterations");
   int ba_refine_iterations = setting_keys::int_default("mapping.ba_refine_iterations");
   int triangulation_neighbours = setting_keys::int_default("mapping.triangulation_neighbours");
-  int max_ba_keyframes = setting_keys::int_default("mapping.max_ba_keyframes");  // optimised keyframes per Local BA (the most covisible); others observing stay fixed
-  double keyframe_redundancy = setting_keys::real_default("mapping.keyframe_redundancy");  // share of points seen by >= 3 other keyframes that makes a keyframe redundant
+  int max_ba_keyframes = setting_keys::int_default("mapping.max_ba_keyframes");
+  double keyframe_redundancy = setting_keys::real_default("mapping.keyframe_redundancy");
+  double min_found_ratio = setting_keys::real_default("mapping.min_found_ratio");
   bool cull_keyframes = setting_keys::bool_default("mapping.cull_keyframes");
   optim::LocalBaObserver ba_observer;  // debug/benchmark hook: sees every Local BA problem (empty: none)
 };

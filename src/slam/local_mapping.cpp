@@ -159,7 +159,7 @@ void LocalMapper::cull_recent_points(const KeyFramePtr& kf) {
     const long age = kf->id() - mp->first_keyframe_id();
     if (mp->is_bad()) {
       it = recent_points_.erase(it);
-    } else if (mp->found_ratio() < 0.25 || (age >= 2 && mp->num_observations() <= kMinObservations)) {
+    } else if (mp->found_ratio() < cfg_.min_found_ratio || (age >= 2 && mp->num_observations() <= kMinObservations)) {
       mp->set_bad();
       ++culled;
       it = recent_points_.erase(it);
@@ -179,6 +179,7 @@ void LocalMapper::triangulate(const KeyFramePtr& kf) {
   const Eigen::Isometry3d T1_inv = T1.inverse();
   const Eigen::Vector3d C1 = T1_inv.translation();
   const double baseline = A.camera.bf / A.camera.fx;
+  // A point's distances from the two keyframes must agree with the scales it was seen at, within this factor.
   const double ratio_factor = 1.5 * S.scale_factor;
   const auto normalized = [&](const cv::KeyPoint& kp) {
     return Eigen::Vector2d((kp.pt.x - A.camera.cx) / A.camera.fx, (kp.pt.y - A.camera.cy) / A.camera.fy);
@@ -198,7 +199,8 @@ void LocalMapper::triangulate(const KeyFramePtr& kf) {
       const Eigen::Vector3d r1 = T1_inv.rotation() * x1.homogeneous();
       const Eigen::Vector3d r2 = T2_inv.rotation() * x2.homogeneous();
       const double cos_parallax = r1.dot(r2) / (r1.norm() * r2.norm());
-      if (cos_parallax <= 0 || cos_parallax > 0.9998) continue;  // need about a degree of parallax
+      constexpr double kMaxCosParallax = 0.9998;  // about a degree of parallax: less triangulates depth noise
+      if (cos_parallax <= 0 || cos_parallax > kMaxCosParallax) continue;
       Eigen::Vector3d pw;
       if (!triangulate_dlt(T1, T2, x1, x2, pw)) continue;
       const Eigen::Vector3d p1 = T1 * pw, p2 = T2 * pw;
@@ -206,7 +208,7 @@ void LocalMapper::triangulate(const KeyFramePtr& kf) {
       const auto reproj_ok = [&](const Eigen::Vector3d& pc, const cv::KeyPoint& kp) {
         const Eigen::Vector2d uv = A.camera.project(pc);
         const double e2 = (uv - Eigen::Vector2d(kp.pt.x, kp.pt.y)).squaredNorm();
-        return e2 <= 5.991 * S.level_sigma2[kp.octave];
+        return e2 <= optim::kChi2Mono * S.level_sigma2[kp.octave];
       };
       if (!reproj_ok(p1, k1) || !reproj_ok(p2, k2)) continue;
       const double d1 = (pw - C1).norm(), d2 = (pw - C2).norm();

@@ -11,6 +11,24 @@ namespace varslam::slam {
 
 namespace {
 
+// A map point is matched only where it is seen within 60 deg of its mean viewing direction (descriptors change
+// beyond that).
+constexpr double kMinViewCos = 0.5;
+// Local-map search radius (pixels at level 0, times the level's scale): narrow where the point is seen head-on,
+// wider at an angle, where its scale prediction is less sure.
+constexpr double kFrontalViewCos = 0.998, kFrontalRadius = 2.5, kObliqueRadius = 4.0;
+// Best and second-best candidates at the same scale closer than this ratio: ambiguous, no match.
+constexpr double kSameScaleRatio = 0.8;
+// Nearest-neighbour ratio of the descriptor matching against a keyframe (Lowe's test).
+constexpr double kKeyframeMatchRatio = 0.7;
+// Fusion gates on the squared reprojection error at the keypoint's scale, 2 and 3 dof, as ORB-SLAM writes them
+// (the 95 % chi-square quantiles 5.991 and 7.815, rounded).
+constexpr double kFuseGateMono = 5.99, kFuseGateStereo = 7.8;
+// Triangulation matches lie within the 95 % chi-square (1 dof) band of the epipolar line ...
+constexpr double kEpipolarGate = 3.84;
+// ... and not within 10 pixels (squared, at level 0) of the epipole, where the line says nothing.
+constexpr double kMinEpipoleDistance2 = 100.0;
+
 const std::uint8_t* row_ptr(const cv::Mat& m, int r) { return m.ptr<std::uint8_t>(r); }
 
 /// The two closest descriptors to a projected map point among the frame's candidate keypoints, with their levels.
@@ -122,10 +140,11 @@ int match_local_map(Frame& cur, const std::vector<MapPointPtr>& points, double r
     if (dist < mp->min_distance() || dist > mp->max_distance()) continue;
     const Eigen::Vector3d nrm = mp->normal();
     const double view_cos = nrm.norm() > 0 ? ray.dot(nrm) / (dist * nrm.norm()) : 1.0;
-    if (view_cos < 0.5) continue;
+    if (view_cos < kMinViewCos) continue;
     if (tracking) mp->increase_visible();
     const int level = mp->predict_scale(dist, S.log_scale_factor, S.n_levels);
-    const double r = radius_scale * (view_cos > 0.998 ? 2.5 : 4.0) * S.scale_factors[level];
+    const double r =
+        radius_scale * (view_cos > kFrontalViewCos ? kFrontalRadius : kObliqueRadius) * S.scale_factors[level];
     const std::vector<int> cands = F.in_area(uv.x(), uv.y(), r, level - 1, level);
     if (cands.empty()) continue;
     const cv::Mat d = mp->descriptor();
@@ -133,7 +152,7 @@ int match_local_map(Frame& cur, const std::vector<MapPointPtr>& points, double r
     const auto [best, second, best_idx, best_level, second_level] =
         score_candidates(cur, cands, d, uv.x() - F.camera.bf / pc.z(), r);
     if (best_idx < 0 || best > kDescDistHigh) continue;
-    if (best_level == second_level && best > 0.8 * second) continue;  // ambiguous at the same scale
+    if (best_level == second_level && best > kSameScaleRatio * second) continue;
     if (!cur.map_points[best_idx]) ++n;
     cur.map_points[best_idx] = mp;
     cur.outlier[best_idx] = false;
@@ -151,7 +170,7 @@ int match_keyframe_by_descriptor(Frame& cur, const KeyFrame& kf) {
   if (rows.empty() || F.descriptors.empty()) return 0;
   cv::Mat query(static_cast<int>(rows.size()), K.descriptors.cols, K.descriptors.type());
   for (std::size_t r = 0; r < rows.size(); ++r) K.descriptors.row(rows[r]).copyTo(query.row(static_cast<int>(r)));
-  const auto matches = match_descriptors(query, F.descriptors, kDescDistLow, 0.7, true);
+  const auto matches = match_descriptors(query, F.descriptors, kDescDistLow, kKeyframeMatchRatio, true);
   int n = 0;
   std::vector<std::pair<int, float>> rot;
   for (const auto& m : matches) {
@@ -182,7 +201,7 @@ int fuse_into_keyframe(const KeyFramePtr& kf, const std::vector<MapPointPtr>& po
     const double dist = ray.norm();
     if (dist < mp->min_distance() || dist > mp->max_distance()) continue;
     const Eigen::Vector3d nrm = mp->normal();
-    if (nrm.norm() > 0 && ray.dot(nrm) < 0.5 * dist * nrm.norm()) continue;
+    if (nrm.norm() > 0 && ray.dot(nrm) < kMinViewCos * dist * nrm.norm()) continue;
     const int level = mp->predict_scale(dist, S.log_scale_factor, S.n_levels);
     const double r = radius * S.scale_factors[level];
     const std::vector<int> cands = K.in_area(uv.x(), uv.y(), r);
@@ -197,11 +216,11 @@ int fuse_into_keyframe(const KeyFramePtr& kf, const std::vector<MapPointPtr>& po
       // Reprojection gate at the keypoint's scale (chi2 2 or 3 dof, 95%).
       const double ex = uv.x() - K.keypoints[c].pt.x, ey = uv.y() - K.keypoints[c].pt.y;
       double e2 = ex * ex + ey * ey;
-      double gate = 5.99;
+      double gate = kFuseGateMono;
       if (K.u_right[c] > 0) {
         const double er = ur_pred - K.u_right[c];
         e2 += er * er;
-        gate = 7.8;
+        gate = kFuseGateStereo;
       }
       if (e2 * S.inv_level_sigma2[kl] > gate) continue;
       const int dd = descriptor_distance(d.ptr<std::uint8_t>(), row_ptr(K.descriptors, c));
@@ -255,9 +274,9 @@ std::vector<std::pair<int, int>> match_for_triangulation(const KeyFrame& kf1, co
     for (int j : free2) {
       const cv::KeyPoint& kp2 = B.keypoints[j];
       const double dist_line = line.x() * kp2.pt.x + line.y() * kp2.pt.y + line.z();
-      if (dist_line * dist_line / norm2 > 3.84 * S.level_sigma2[kp2.octave]) continue;
+      if (dist_line * dist_line / norm2 > kEpipolarGate * S.level_sigma2[kp2.octave]) continue;
       const double dx = ep.x() - kp2.pt.x, dy = ep.y() - kp2.pt.y;
-      if (dx * dx + dy * dy < 100 * S.scale_factors[kp2.octave]) continue;
+      if (dx * dx + dy * dy < kMinEpipoleDistance2 * S.scale_factors[kp2.octave]) continue;
       const int dd = descriptor_distance(row_ptr(A.descriptors, static_cast<int>(i)), row_ptr(B.descriptors, j));
       if (dd < best) {
         best = dd;

@@ -169,8 +169,8 @@ bool Tracker::initialize(Frame& cur, const Eigen::Isometry3d& T_cw) {
 
 void Tracker::refresh_last_frame() {
   // The reference keyframe may have moved (Local BA): re-anchor the last pose to it. A keyframe frame keeps
-  // its own pose unless a loop correction moved the map (re-anchoring it after every Local BA measured
-  // worse on the kitchen, 5.66 against 4.63 cm).
+  // its own pose unless a loop correction moved the map (re-anchoring it after every Local BA measured worse:
+  // BENCHMARKS.md, "Why the defaults are what they are").
   const long corrections = map_.corrections();
   const bool map_corrected = corrections != seen_corrections_;
   seen_corrections_ = corrections;
@@ -438,6 +438,7 @@ void Tracker::clean_temporary_matches(Frame& cur) {
 bool Tracker::need_keyframe(const Frame& cur, int inliers) const {
   if (!reference_kf_) return true;
   const std::size_t n_kfs = map_.num_keyframes();
+  // The reference keyframe's points that count: seen by 3 keyframes (2 while the map is that small).
   const int min_obs = n_kfs <= 2 ? 2 : 3;
   const int ref_matches = reference_kf_->tracked_map_points(min_obs);
   const bool mapping_idle = sink_.accepts_keyframes();
@@ -451,20 +452,24 @@ bool Tracker::need_keyframe(const Frame& cur, int inliers) const {
   // Many close points seen but few of them in the map: a keyframe adds cheap, well-constrained structure.
   // ORB-SLAM3 would take one at every such frame; with a person close to the camera that is every frame (its
   // keypoints are close and never tracked), flooding the map. A short gap keeps the rule for real new structure.
-  const bool need_close = tracked_close < 100 && untracked_close > 70 &&
-                          cur.id >= last_kf_frame_id_ + cfg_.tracking.close_keyframe_gap;
-  const double ref_ratio = n_kfs < 2 ? 0.4 : 0.75;
-  const long max_frames = std::max<long>(1, std::lround(cfg_.fps));
+  const TrackingConfig& tc = cfg_.tracking;
+  const bool need_close = tracked_close < tc.close_tracked_max && untracked_close > tc.close_untracked_min &&
+                          cur.id >= last_kf_frame_id_ + tc.close_keyframe_gap;
+  // While the map has one keyframe, every frame sees it well: ask for less overlap before the second.
+  constexpr double kFirstKeyframesRatio = 0.4;
+  const double ref_ratio = n_kfs < 2 ? kFirstKeyframesRatio : tc.keyframe_inlier_ratio;
+  const long max_frames = std::max<long>(1, std::lround(cfg_.fps));  // at least one keyframe a second
   const bool c1a = cur.id >= last_kf_frame_id_ + max_frames;
   const bool c1b = mapping_idle;
-  const bool c1c = inliers < ref_matches * 0.25 || need_close;
-  const bool c2 = (inliers < ref_matches * ref_ratio || need_close) && inliers > 15;
+  const bool c1c = inliers < ref_matches * tc.keyframe_urgent_ratio || need_close;
+  const bool c2 = (inliers < ref_matches * ref_ratio || need_close) && inliers > tc.keyframe_min_inliers;
   spdlog::debug("frame {}: inliers {} ref_matches {} close tracked {} untracked {} -> c1a {} c1c {} c2 {}", cur.id,
                 inliers, ref_matches, tracked_close, untracked_close, c1a, c1c, c2);
   if (!((c1a || c1b || c1c) && c2)) return false;
   if (mapping_idle) return true;
   sink_.interrupt_ba();
-  return sink_.queued() < 3;
+  constexpr std::size_t kMaxQueuedKeyframes = 3;  // beyond this, mapping falls behind: skip this one
+  return sink_.queued() < kMaxQueuedKeyframes;
 }
 
 void Tracker::create_keyframe(Frame& cur) { insert_keyframe_with_depth_points(cur, false); }
