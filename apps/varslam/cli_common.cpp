@@ -35,6 +35,8 @@ void print_run_summary(const run::RunSummary& s) {
   }
   if (s.ate_rmse)
     fmt::print("ATE              rmse {:.2f} cm, max {:.2f} cm\n", *s.ate_rmse * 100.0, *s.ate_max * 100.0);
+  else if (!s.ate_note.empty())
+    fmt::print("ATE              {}\n", s.ate_note);
   else
     fmt::print("ATE              (no ground truth)\n");
   fmt::print("trajectory       {}\n", (s.out_dir / "CameraTrajectory.txt").string());

@@ -1,17 +1,48 @@
 // `varslam run`: SLAM over a dataset folder (TUM RGB-D / Bonn / OpenLORIS layouts, or a synthetic sequence).
+#include <fmt/format.h>
+#include <signal.h>
 #include <spdlog/spdlog.h>
+
+#include <atomic>
 
 #include "cli_common.hpp"
 #include "commands.hpp"
 #include "io/dataset.hpp"
 
 namespace varslam::cli {
+namespace {
+
+// Set by SIGINT / SIGTERM, read by the run loop: the one piece of process-wide state a signal handler needs.
+std::atomic<bool> g_stop_requested{false};
+extern "C" void request_stop(int) { g_stop_requested.store(true); }
+
+// The first SIGINT or SIGTERM ends the run cleanly (what was tracked is written); a second one kills at once.
+void stop_cleanly_on_signals() {
+  struct sigaction sa {};
+  sa.sa_handler = request_stop;
+  sa.sa_flags = SA_RESETHAND;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+}
+
+// Frame counts and indices: CLI11 would wrap "-1" around to the largest size_t ("all frames").
+const CLI::Validator kCount(
+    [](std::string& v) {
+      return v.find_first_not_of("0123456789") == std::string::npos && !v.empty()
+                 ? std::string()
+                 : "expected a whole number of frames, 0 or more, got '" + v + "'";
+    },
+    "COUNT");
+
+}  // namespace
 
 void add_run_command(CLI::App& app) {
   struct Opts {
     std::string dataset, settings, out = "out/run", groundtruth;
     bool realtime = false, pace = false, quiet = false;
     std::size_t first = 0, max_frames = SIZE_MAX;
+    double min_tracked_share = 0.5;
     std::vector<std::string> overrides;
     std::vector<std::size_t> debug_frames;
   };
@@ -23,8 +54,12 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("--groundtruth", o->groundtruth, "Ground truth TUM file (default: <dataset>/groundtruth.txt)");
   cmd->add_flag("--realtime", o->realtime, "Real-time mode: local mapping on its own thread");
   cmd->add_flag("--pace", o->pace, "With --realtime: feed frames at the dataset's frame rate");
-  cmd->add_option("--first", o->first, "First frame index");
-  cmd->add_option("--max-frames,-n", o->max_frames, "Process at most this many frames");
+  cmd->add_option("--first", o->first, "First frame index")->check(kCount);
+  cmd->add_option("--max-frames,-n", o->max_frames, "Process at most this many frames")->check(kCount);
+  cmd->add_option("--min-tracked-share", o->min_tracked_share,
+                  "A run tracking a smaller share of its frames fails (exit 4); 0 accepts any run")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--set", o->overrides, "Override a setting: section.key=value (repeatable)");
   cmd->add_flag("--quiet,-q", o->quiet, "No progress line");
   cmd->add_option("--debug-frames", o->debug_frames,
@@ -44,9 +79,17 @@ void add_run_command(CLI::App& app) {
     ro.progress = !o->quiet;
     ro.debug_frames.insert(o->debug_frames.begin(), o->debug_frames.end());
     if (!o->groundtruth.empty()) ro.groundtruth = o->groundtruth;
+    ro.min_tracked_share = o->min_tracked_share;
+    ro.stop = &g_stop_requested;
+    stop_cleanly_on_signals();
     const run::RunSummary s = run::run_slam(*dataset, settings, ro, o->out);
     write_report_for_run(s.out_dir, o->dataset);
     print_run_summary(s);
+    if (s.interrupted)
+      throw CommandFailed(fmt::format("interrupted after {} frames; what was tracked is in {}", s.frames,
+                                      s.out_dir.string()),
+                          kExitInterrupted);
+    if (s.failure) throw CommandFailed("tracking failed: " + *s.failure, kExitTrackingFailed);
   });
 }
 

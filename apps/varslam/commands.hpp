@@ -4,6 +4,14 @@
 
 namespace varslam::cli {
 
+/// A command that ran but failed (a run that tracked almost nothing, an interrupted run): main() exits with
+/// `code` after the command printed what it has.
+struct CommandFailed : std::runtime_error {
+  CommandFailed(const std::string& what, int exit_code) : std::runtime_error(what), code(exit_code) {}
+  int code;
+};
+inline constexpr int kExitInputError = 2, kExitInternalError = 3, kExitTrackingFailed = 4, kExitInterrupted = 130;
+
 void add_run_command(CLI::App& app);
 void add_eval_command(CLI::App& app);
 void add_synth_command(CLI::App& app);

@@ -25,12 +25,15 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
+  } catch (const varslam::cli::CommandFailed& e) {
+    spdlog::error("{}", e.what());
+    return e.code;
   } catch (const varslam::InputError& e) {
     spdlog::error("{}", e.what());
-    return 2;
+    return varslam::cli::kExitInputError;
   } catch (const std::exception& e) {
     spdlog::error("internal error: {}", e.what());
-    return 3;
+    return varslam::cli::kExitInternalError;
   }
   return 0;
 }

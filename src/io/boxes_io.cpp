@@ -25,6 +25,12 @@ BoxesByTime read_boxes_file(const std::filesystem::path& file) {
     for (double x : v)
       if (!std::isfinite(x)) throw InputError(fmt::format("{}: non-finite value in '{}'", l.where, *l.text));
     if (v[4] < 0 || v[5] < 0) throw InputError(fmt::format("{}: negative box size in '{}'", l.where, *l.text));
+    // Pixels and scores as floats: beyond this a value is garbage, and converting it would be undefined.
+    constexpr double kMaxValue = 1e7;
+    for (int k = 1; k < 6; ++k)
+      if (std::abs(v[k]) > kMaxValue)
+        throw InputError(fmt::format("{}: value {} out of range (at most {:g} in magnitude) in '{}'", l.where, v[k],
+                                     kMaxValue, *l.text));
     d.timestamp = v[0];
     d.score = static_cast<float>(v[1]);
     d.box = cv::Rect2f(static_cast<float>(v[2]), static_cast<float>(v[3]), static_cast<float>(v[4]),

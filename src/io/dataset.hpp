@@ -12,6 +12,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <vector>
 #include <thread>
 
 #include "core/rgbd_frame.hpp"
@@ -43,6 +44,12 @@ std::unique_ptr<Dataset> open_dataset(const std::filesystem::path& dir, const Se
 Settings settings_for_dataset(const std::filesystem::path& dir, const std::optional<std::filesystem::path>& file);
 
 /// Decodes frames [first, first + count) ahead on its own thread so decoding overlaps with processing.
+/// A frame the prefetcher could not read, and why.
+struct SkippedFrame {
+  std::size_t index = 0;
+  std::string reason;
+};
+
 class FramePrefetcher {
  public:
   /// `prepare` (optional) runs on each loaded frame on the prefetch thread, e.g. depth registration.
@@ -56,6 +63,7 @@ class FramePrefetcher {
   /// if more than max(10, 10% of the requested frames) fail, throws InputError (the dataset is broken).
   std::optional<RgbdFrame> next();
   std::size_t skipped() const;
+  std::vector<SkippedFrame> skipped_frames() const;
 
  private:
   void run();
@@ -69,6 +77,7 @@ class FramePrefetcher {
   std::condition_variable not_full_, not_empty_;
   std::deque<RgbdFrame> queue_;
   std::size_t skipped_ = 0;
+  std::vector<SkippedFrame> skipped_frames_;
   bool done_ = false;
   bool stop_ = false;
   std::exception_ptr error_;

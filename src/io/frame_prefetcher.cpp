@@ -41,6 +41,7 @@ void FramePrefetcher::run() {
       } catch (const InputError& e) {
         std::lock_guard lock(mutex_);
         ++skipped_;
+        skipped_frames_.push_back({i, e.what()});
         spdlog::warn("skipping frame {}: {}", i, e.what());
         if (skipped_ > max_skips)
           throw InputError(fmt::format("{}: {} of {} frames could not be read (more than {}); the dataset looks "
@@ -84,6 +85,11 @@ std::optional<RgbdFrame> FramePrefetcher::next() {
 std::size_t FramePrefetcher::skipped() const {
   std::lock_guard lock(mutex_);
   return skipped_;
+}
+
+std::vector<SkippedFrame> FramePrefetcher::skipped_frames() const {
+  std::lock_guard lock(mutex_);
+  return skipped_frames_;
 }
 
 }  // namespace varslam

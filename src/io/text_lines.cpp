@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -18,6 +19,9 @@ bool parse_double(const std::string& token, double& out) {
 
 void for_each_data_line(const std::filesystem::path& file, const std::string& what,
                         const std::function<void(const TextLine&)>& fn) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec))
+    throw InputError(fmt::format("{}: is a folder; expected a {}", file.string(), what));
   std::ifstream in(file);
   if (!in) throw InputError(fmt::format("{}: cannot open {}", file.string(), what));
   std::string line;

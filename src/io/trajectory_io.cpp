@@ -11,11 +11,17 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "io/atomic_file.hpp"
 #include "io/text_lines.hpp"
 
 namespace varslam {
 namespace {
 
+}  // namespace
+
+namespace {
+// Beyond this a coordinate is garbage (and squared in the ATE it would overflow), whatever the unit.
+constexpr double kMaxCoordinate = 1e6;
 }  // namespace
 
 Trajectory read_tum_trajectory(const std::filesystem::path& file) {
@@ -34,6 +40,10 @@ Trajectory read_tum_trajectory(const std::filesystem::path& file) {
     for (double x : v)
       if (!std::isfinite(x))
         throw InputError(fmt::format("{}:{}: non-finite value in '{}'", file.string(), line_no, line));
+    for (int k = 1; k <= 3; ++k)
+      if (std::abs(v[k]) > kMaxCoordinate)
+        throw InputError(fmt::format("{}:{}: position {} m is not a camera position (more than {:g} m from the origin)",
+                                     file.string(), line_no, v[k], kMaxCoordinate));
     if (!out.empty() && v[0] < out.back().timestamp)
       throw InputError(fmt::format("{}:{}: timestamp {:.6f} is before {:.6f} (line {}); timestamps must "
                                    "increase",
@@ -64,16 +74,14 @@ Trajectory read_tum_trajectory(const std::filesystem::path& file) {
 }
 
 void write_tum_trajectory(const Trajectory& trajectory, const std::filesystem::path& file) {
-  std::ofstream out(file);
-  if (!out) throw InputError(fmt::format("{}: cannot write trajectory file", file.string()));
-  out << "# timestamp tx ty tz qx qy qz qw (camera-to-world)\n";
+  std::string text = "# timestamp tx ty tz qx qy qz qw (camera-to-world)\n";
   for (const auto& p : trajectory) {
     const Eigen::Quaterniond q = Eigen::Quaterniond(p.T_wc.linear()).normalized();
     const Eigen::Vector3d t = p.T_wc.translation();
-    out << fmt::format("{:.6f} {:.9g} {:.9g} {:.9g} {:.9g} {:.9g} {:.9g} {:.9g}\n", p.timestamp, t.x(), t.y(),
-                       t.z(), q.x(), q.y(), q.z(), q.w());
+    text += fmt::format("{:.6f} {:.9g} {:.9g} {:.9g} {:.9g} {:.9g} {:.9g} {:.9g}\n", p.timestamp, t.x(), t.y(), t.z(),
+                        q.x(), q.y(), q.z(), q.w());
   }
-  if (!out) throw InputError(fmt::format("{}: error while writing trajectory file", file.string()));
+  write_file_atomically(file, text, "trajectory file");
 }
 
 }  // namespace varslam

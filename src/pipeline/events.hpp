@@ -26,7 +26,7 @@ struct FrameResult {
   bool keyframe = false;     // the frame became a keyframe
   long keyframe_id = -1;
   bool new_segment = false;  // tracking was lost and a new map segment started here
-  int keypoints = 0, inliers = 0, depth_edge_rejected = 0;
+  int keypoints = 0, keypoints_with_depth = 0, inliers = 0, depth_edge_rejected = 0;
   slam::FrameTimings timings;
   // The pose tracking gave the frame, camera-to-world (what a robot uses live); empty when it was not tracked.
   std::optional<Eigen::Isometry3d> T_wc;

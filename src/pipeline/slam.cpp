@@ -223,6 +223,7 @@ FrameResult Slam::track(const RgbdFrame& input, const std::optional<Detections>&
   r.keyframe_id = out.keyframe_id;
   r.new_segment = out.new_segment;
   r.keypoints = out.keypoints;
+  r.keypoints_with_depth = out.keypoints_with_depth;
   r.inliers = out.inliers;
   r.depth_edge_rejected = out.depth_edge_rejected;
   r.timings = out.timings;

@@ -3,6 +3,10 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
 #include <chrono>
 #include <fstream>
 #include <thread>
@@ -10,6 +14,7 @@
 #include "core/error.hpp"
 #include "eval/ate.hpp"
 #include "eval/rpe.hpp"
+#include "io/atomic_file.hpp"
 #include "io/trajectory_io.hpp"
 #include "run/filter_stage_writer.hpp"
 #include "run/metrics_recorder.hpp"
@@ -34,10 +39,9 @@ std::vector<RgbdFrame> registration_samples(const Dataset& ds, std::size_t first
 }
 
 // ATE and RPE against ground truth, into the metrics, with the aligned trajectory next to the others.
-void evaluate_against(const std::filesystem::path& gt_path, const Trajectory& traj, const Trajectory& live,
+void evaluate_against(const Trajectory& gt, const Trajectory& traj, const Trajectory& live,
                       const std::vector<double>& stamps, const std::filesystem::path& out_dir, nlohmann::json& m,
                       RunSummary& sum) {
-  const Trajectory gt = read_tum_trajectory(gt_path);
   try {
     const AteResult ate = evaluate_ate(gt, traj);
     sum.ate_rmse = ate.stats.rmse;
@@ -59,31 +63,91 @@ void evaluate_against(const std::filesystem::path& gt_path, const Trajectory& tr
       m["ate_live"] = {{"rmse", live_ate.stats.rmse}, {"max", live_ate.stats.max}, {"pairs", live_ate.stats.count}};
     }
   } catch (const InputError& e) {
-    spdlog::warn("ATE not computed: {}", e.what());
+    sum.ate_note = fmt::format("not computed: {}", e.what());
   }
 }
+
+// What a run that tracked almost nothing most likely lacked.
+std::string likely_cause(const MetricsRecorder& metrics, const Settings& settings) {
+  constexpr double kFewKeypoints = 100;     // tracking needs a few hundred; below this the images carry no texture
+  constexpr double kLittleDepth = 0.2;      // share of keypoints with depth below which RGB-D tracking cannot work
+  if (metrics.frames() == 0) return "no frame was read";
+  if (metrics.median_keypoints() < kFewKeypoints)
+    return fmt::format("the frames have a median of {:.0f} ORB keypoints (black, blank or tiny images, or orb.n_features "
+                       "too small)",
+                       metrics.median_keypoints());
+  if (metrics.median_depth_share() < kLittleDepth)
+    return fmt::format("only {:.0f} % of the keypoints have a depth (depth images all zero or saturated, or "
+                       "depth.factor {} wrong for this sensor)",
+                       100.0 * metrics.median_depth_share(), settings.depth_factor);
+  return "keypoints and depth look usable: fast motion, a wrong camera model, or a scene dominated by movers";
+}
+
+// The run's folder: created, cleared of an earlier run's outputs, and held against a concurrent run.
+class OutputFolder {
+ public:
+  explicit OutputFolder(const std::filesystem::path& dir) {
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    if (ec || !std::filesystem::is_directory(dir))
+      throw InputError(fmt::format("{}: cannot create the output folder: {}", dir.string(),
+                                   ec ? ec.message() : std::string("a file of that name exists")));
+    const std::filesystem::path lock = dir / ".varslam.lock";
+    fd_ = ::open(lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0) throw InputError(fmt::format("{}: cannot write into the output folder", dir.string()));
+    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+      ::close(fd_);
+      throw InputError(fmt::format("{}: another varslam run is writing into this folder; give this one another --out",
+                                   dir.string()));
+    }
+    // An earlier run's files would sit beside this run's and read as its results.
+    int removed = 0;
+    for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
+      const std::string name = e.path().filename().string();
+      const bool ours = name == "CameraTrajectory.txt" || name == "CameraTrajectory_aligned.txt" ||
+                        name == "KeyFrameTrajectory.txt" || name == "LiveTrajectory.txt" || name == "map.ply" ||
+                        name == "metrics.json" || name == "report.html" || name.rfind("semantic_stages_", 0) == 0;
+      if (ours && std::filesystem::remove(e.path(), ec)) ++removed;
+    }
+    if (removed > 0) spdlog::info("{}: removed {} files of an earlier run", dir.string(), removed);
+  }
+  ~OutputFolder() {
+    ::flock(fd_, LOCK_UN);
+    ::close(fd_);
+  }
+  OutputFolder(const OutputFolder&) = delete;
+  OutputFolder& operator=(const OutputFolder&) = delete;
+
+ private:
+  int fd_ = -1;
+};
 
 }  // namespace
 
 void write_map_ply(const slam::Map& map, const std::filesystem::path& file) {
-  std::ofstream out(file);
-  if (!out) throw InputError(fmt::format("{}: cannot write the map", file.string()));
   std::vector<Eigen::Vector3d> pts;
   for (const auto& mp : map.map_points())
     if (!mp->is_bad()) pts.push_back(mp->position());
-  out << "ply\nformat ascii 1.0\ncomment varslam map points (world frame, metres)\n";
-  out << "element vertex " << pts.size() << "\nproperty float x\nproperty float y\nproperty float z\n";
-  out << "end_header\n";
-  for (const auto& p : pts) out << fmt::format("{:.5f} {:.5f} {:.5f}\n", p.x(), p.y(), p.z());
+  std::string text = "ply\nformat ascii 1.0\ncomment varslam map points (world frame, metres)\n";
+  text += fmt::format("element vertex {}\nproperty float x\nproperty float y\nproperty float z\nend_header\n",
+                      pts.size());
+  for (const auto& p : pts) text += fmt::format("{:.5f} {:.5f} {:.5f}\n", p.x(), p.y(), p.z());
+  write_file_atomically(file, text, "map");
 }
 
 RunSummary run_slam(const Dataset& dataset, const Settings& settings, const RunOptions& options,
                     const std::filesystem::path& out_dir) {
-  std::filesystem::create_directories(out_dir);
   const std::size_t first = std::min(options.first, dataset.size());
   const std::size_t count = std::min(options.max_frames, dataset.size() - first);
   if (count == 0) throw InputError(fmt::format("{}: no frames to process", dataset.root().string()));
+  // Checked before the run, so a broken file does not cost one.
+  const auto gt_path = options.groundtruth ? options.groundtruth : dataset.groundtruth();
+  std::optional<Trajectory> groundtruth;
+  if (options.groundtruth && !std::filesystem::exists(*options.groundtruth))
+    throw InputError(fmt::format("{}: ground truth file not found", options.groundtruth->string()));
+  if (gt_path && std::filesystem::exists(*gt_path)) groundtruth = read_tum_trajectory(*gt_path);
 
+  const OutputFolder out(out_dir);
   Slam slam(settings, SlamOptions{options.mode, nullptr});
   MetricsRecorder metrics;
   slam.add_observer(metrics);
@@ -99,7 +163,12 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const RunO
   FramePrefetcher prefetch(dataset, 4, first, count, slam.frame_preparation());
   const auto t_start = Clock::now();
   double first_stamp = 0;
+  bool interrupted = false;
   for (std::size_t n = 0;; ++n) {
+    if (options.stop && options.stop->load()) {
+      interrupted = true;
+      break;
+    }
     const auto t_load = Clock::now();
     std::optional<RgbdFrame> frame = prefetch.next();
     if (!frame) break;
@@ -117,6 +186,7 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const RunO
 
   RunSummary sum;
   sum.out_dir = out_dir;
+  sum.interrupted = interrupted;
   const SlamSummary s = slam.summary();
   sum.frames = metrics.frames();
   sum.tracked = metrics.tracked();
@@ -137,11 +207,24 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const RunO
   m["dataset"] = dataset.root().string();
   m["wall_seconds"] = wall;
   m["fps"] = sum.fps;
-  const auto gt_path = options.groundtruth ? options.groundtruth : dataset.groundtruth();
-  if (gt_path && std::filesystem::exists(*gt_path) && traj.size() >= 2)
-    evaluate_against(*gt_path, traj, slam.live_trajectory(), metrics.frame_timestamps(), out_dir, m, sum);
+  nlohmann::json skipped = nlohmann::json::array();
+  for (const SkippedFrame& f : prefetch.skipped_frames()) skipped.push_back({{"index", f.index}, {"reason", f.reason}});
+  m["skipped_frames"] = skipped;
+  if (groundtruth && traj.size() >= 2) {
+    evaluate_against(*groundtruth, traj, slam.live_trajectory(), metrics.frame_timestamps(), out_dir, m, sum);
+  } else if (groundtruth) {
+    sum.ate_note = fmt::format("not computed: {} tracked pose{} (2 needed)", traj.size(), traj.size() == 1 ? "" : "s");
+  }
+  if (!sum.ate_note.empty()) m["ate_note"] = sum.ate_note;
+  const double share = sum.frames ? static_cast<double>(sum.tracked) / static_cast<double>(sum.frames) : 0.0;
+  if (share < options.min_tracked_share)
+    sum.failure = fmt::format("tracked {} of {} frames ({:.0f} %, at least {:.0f} % needed): {}", sum.tracked,
+                              sum.frames, 100.0 * share, 100.0 * options.min_tracked_share,
+                              likely_cause(metrics, settings));
+  m["status"] = interrupted ? "interrupted" : sum.failure ? "failed" : "ok";
+  if (sum.failure) m["failure"] = *sum.failure;
   sum.metrics = m;
-  std::ofstream(out_dir / "metrics.json") << m.dump(2) << "\n";
+  write_file_atomically(out_dir / "metrics.json", m.dump(2) + "\n", "metrics file");
   return sum;
 }
 

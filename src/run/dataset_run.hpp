@@ -2,6 +2,7 @@
 // Runs the pipeline over a dataset and writes what a user opens afterwards: TUM trajectories, the map as PLY,
 // metrics.json (with the ATE and RPE when ground truth exists). The dataset loop, pacing and the file writers;
 // everything SLAM is varslam::Slam.
+#include <atomic>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -23,6 +24,9 @@ struct RunOptions {
   std::optional<std::filesystem::path> groundtruth;  // overrides the dataset's groundtruth.txt
   std::set<std::size_t> debug_frames;  // frame indices for which the semantic filter's stages are drawn
   std::vector<Observer*> observers;    // more observers of the pipeline (e.g. a live viewer)
+  // A run tracking a smaller share of its frames failed (RunSummary::failure says why); 0 accepts any run.
+  double min_tracked_share = 0.5;
+  const std::atomic<bool>* stop = nullptr;  // set (e.g. by a signal handler) to end the run early, cleanly
 };
 
 struct RunSummary {
@@ -30,12 +34,17 @@ struct RunSummary {
   int segments = 0;
   double wall_seconds = 0, fps = 0;
   std::optional<double> ate_rmse, ate_max;
+  std::string ate_note;          // why there is no ATE although ground truth exists
+  std::optional<std::string> failure;  // the run tracked too little: the share and the likely cause
+  bool interrupted = false;      // stopped through RunOptions::stop; the outputs hold what was tracked
   nlohmann::json metrics;
   std::filesystem::path out_dir;
 };
 
 /// Runs SLAM with `settings` (the `semantic:` section decides whether a detector filters known movers; in
-/// deterministic mode detection is waited for, so results do not depend on timing).
+/// deterministic mode detection is waited for, so results do not depend on timing). Ground truth is read before
+/// the run (a broken file fails at once); outputs of an earlier run in `out_dir` are removed first, every output
+/// is written atomically, and a second run into the same folder at the same time is refused (InputError).
 RunSummary run_slam(const Dataset& dataset, const Settings& settings, const RunOptions& options,
                     const std::filesystem::path& out_dir);
 

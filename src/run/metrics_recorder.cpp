@@ -48,6 +48,7 @@ void MetricsRecorder::on_frame(const FrameResult& f) {
   track_.push_back(f.timings.track_ms);
   edge_rejected_.push_back(f.depth_edge_rejected);
   keypoints_.push_back(f.keypoints);
+  depth_share_.push_back(f.keypoints > 0 ? static_cast<double>(f.keypoints_with_depth) / f.keypoints : 0.0);
 }
 
 void MetricsRecorder::on_detection(const DetectionEvent& d) {

@@ -29,10 +29,14 @@ class MetricsRecorder final : public Observer {
   const std::vector<double>& frame_timestamps() const { return stamps_; }
   std::size_t frames() const { return stamps_.size(); }
   std::size_t tracked() const { return tracked_; }
+  /// Medians over the frames: ORB keypoints, and the share of them with a valid depth (what a failed run lacked).
+  double median_keypoints() const { return median_p95(keypoints_).first; }
+  double median_depth_share() const { return median_p95(depth_share_).first; }
 
  private:
   nlohmann::json registration_ = {{"mode", "off"}};
-  std::vector<double> stamps_, load_ms_, extract_, filter_, match_, pose_, track_, edge_rejected_, keypoints_;
+  std::vector<double> stamps_, load_ms_, extract_, filter_, match_, pose_, track_, edge_rejected_, keypoints_,
+      depth_share_;
   std::size_t tracked_ = 0;
   std::vector<double> keyframe_ms_, ba_ms_, loop_search_ms_;
   nlohmann::json ba_ = nlohmann::json::array();

@@ -80,6 +80,7 @@ TrackOutcome Tracker::track(const RgbdFrame& input) {
   const auto t_start = Clock::now();
   Frame cur = build_frame(input, out.timings);
   out.keypoints = static_cast<int>(cur.features->size());
+  for (std::size_t i = 0; i < cur.features->size(); ++i) out.keypoints_with_depth += cur.features->has_depth(i);
   out.depth_edge_rejected = cur.features->depth_edge_rejected;
 
   std::shared_lock map_lock(map_.update_mutex());

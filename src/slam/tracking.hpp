@@ -51,6 +51,7 @@ struct TrackOutcome {
   bool new_segment = false;  // tracking was lost and a new map segment started at the predicted pose
   int inliers = 0;
   int keypoints = 0;
+  int keypoints_with_depth = 0;
   int depth_edge_rejected = 0;
   FrameTimings timings;
   // The pose tracking gave the frame, camera-to-world, as a live user gets it (later BA and loop corrections move

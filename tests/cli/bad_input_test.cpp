@@ -1,0 +1,259 @@
+// The CLI on broken but plausible input, as a hostile but fair user would try it: each case is a clear error that
+// names the file or key (exit 2), a failed run that says why (exit 4), or a run that says what it could not do.
+#include <fcntl.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/file.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+#include <thread>
+
+#include "slam/e2e_support.hpp"
+
+namespace varslam {
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+
+const std::string kCli = std::string(VARSLAM_BINARY_DIR) + "/bin/varslam";
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+struct Outcome {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr
+};
+
+Outcome cli(const std::string& args) {
+  const fs::path log = fs::temp_directory_path() / ("varslam_cli_" + std::to_string(::getpid()) + ".log");
+  const int status = std::system((kCli + " " + args + " > " + log.string() + " 2>&1").c_str());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(log)};
+}
+
+const fs::path& base_sequence() {
+  static const fs::path dir = [] {
+    synth::SynthConfig cfg;
+    cfg.scenario = "walking";
+    cfg.seconds = 1.0;
+    cfg.seed = 2;
+    return slam::e2e::cached_sequence("cli_walking_1s", cfg);
+  }();
+  return dir;
+}
+
+// A private copy of the base sequence to break.
+fs::path copy_of_base(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("varslam_cli_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::copy(base_sequence(), d, fs::copy_options::recursive);
+  return d;
+}
+
+fs::path out_path(const std::string& name) {
+  return fs::temp_directory_path() / ("varslam_cli_out_" + name + "_" + std::to_string(::getpid()));
+}
+
+// An output folder that does not exist yet.
+fs::path out_dir(const std::string& name) {
+  fs::remove_all(out_path(name));
+  return out_path(name);
+}
+
+void append(const fs::path& file, const std::string& text) { std::ofstream(file, std::ios::app) << text; }
+
+std::string run_on(const fs::path& seq, const std::string& name, const std::string& extra = "") {
+  return "run -q -d " + seq.string() + " -o " + out_dir(name).string() + " " + extra;
+}
+
+struct SettingsCase {
+  std::string name, set_args, appended_yaml, expect;
+};
+
+class BadSettings : public ::testing::TestWithParam<SettingsCase> {};
+
+// The settings a typo or a bad value used to leave silently at their defaults.
+TEST_P(BadSettings, AreAnErrorNamingKeyAndSource) {
+  const SettingsCase& c = GetParam();
+  fs::path seq = base_sequence();
+  if (!c.appended_yaml.empty()) {
+    seq = copy_of_base(c.name);
+    append(seq / "settings.yaml", c.appended_yaml);
+  }
+  const Outcome r = cli(run_on(seq, c.name, c.set_args));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr(c.expect));
+  if (!c.appended_yaml.empty()) {
+    EXPECT_THAT(r.output, HasSubstr("settings.yaml:"));
+  }
+  if (!c.set_args.empty()) {
+    EXPECT_THAT(r.output, HasSubstr("--set '"));
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cli, BadSettings,
+    ::testing::Values(
+        SettingsCase{"set_key_typo", "--set tracking.kernl=huber", "", "did you mean tracking.kernel?"},
+        SettingsCase{"set_section_typo", "--set trackng.kernel=huber", "", "unknown section 'trackng'"},
+        SettingsCase{"set_unknown", "--set nosuch.key=1", "", "unknown section 'nosuch'"},
+        SettingsCase{"yaml_section_typo", "", "trackng:\n  kernel: huber\n", "did you mean tracking?"},
+        SettingsCase{"yaml_key_typo", "", "tracking: {kernl: huber}\n", "did you mean tracking.kernel?"},
+        SettingsCase{"yaml_second_camera", "", "camera:\n  fx: 500\n", "'camera' appears twice"},
+        SettingsCase{"set_nan", "--set tracking.barron_alpha=.nan", "", "finite"},
+        SettingsCase{"set_nan_edge", "--set depth.edge_ratio=.nan", "", "finite"},
+        SettingsCase{"set_negative_count", "--set tracking.close_keyframe_gap=-5", "", "[1, 1000000]"},
+        SettingsCase{"set_huge_cx", "--set camera.cx=1e300", "", "camera.cx"},
+        SettingsCase{"set_broken_yaml", "'--set' 'camera.fx=[1, 2'", "", "not valid YAML"},
+        SettingsCase{"set_n_levels", "--set orb.n_levels=1000", "", "[1, 32]"}),
+    [](const auto& param_info) { return param_info.param.name; });
+
+TEST(BadInput, AllZeroDepthIsAFailedRunThatSaysWhy) {
+  const fs::path seq = copy_of_base("zero_depth");
+  for (const auto& e : fs::directory_iterator(seq / "depth"))
+    cv::imwrite(e.path().string(), cv::Mat(480, 640, CV_16UC1, cv::Scalar(0)));
+  const Outcome r = cli(run_on(seq, "zero_depth"));
+  EXPECT_EQ(r.exit_code, 4) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("tracking failed"));
+  EXPECT_THAT(r.output, HasSubstr("have a depth"));
+  // Asked to accept it: the run stands.
+  EXPECT_EQ(cli(run_on(seq, "zero_depth_ok", "--min-tracked-share 0")).exit_code, 0);
+}
+
+TEST(BadInput, BlackFramesAreAFailedRunThatSaysWhy) {
+  const fs::path seq = copy_of_base("black");
+  for (const auto& e : fs::directory_iterator(seq / "rgb"))
+    cv::imwrite(e.path().string(), cv::Mat(480, 640, CV_8UC3, cv::Scalar::all(0)));
+  const Outcome r = cli(run_on(seq, "black"));
+  EXPECT_EQ(r.exit_code, 4) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("keypoints"));
+  EXPECT_THAT(slurp(out_path("black") / "metrics.json"), HasSubstr("\"status\": \"failed\""));
+}
+
+TEST(BadInput, UnwritableMetricsIsAnError) {
+  const fs::path out = out_dir("metrics_folder");
+  fs::create_directories(out / "metrics.json" / "inside");
+  const Outcome r = cli("run -q -d " + base_sequence().string() + " -o " + out.string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("metrics.json: cannot write the metrics file: it is a folder"));
+}
+
+TEST(BadInput, GroundTruthProblemsAreFoundBeforeTheRun) {
+  const fs::path seq = copy_of_base("bad_gt");
+  append(seq / "groundtruth.txt", "1 2 3 4 5 6 7\n");
+  const fs::path out = out_dir("bad_gt");
+  const Outcome r = cli("run -q -d " + seq.string() + " -o " + out.string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("groundtruth.txt:"));
+  EXPECT_FALSE(fs::exists(out / "CameraTrajectory.txt")) << "the run should not have started";
+  const Outcome folder = cli(run_on(base_sequence(), "gt_folder", "--groundtruth " + seq.string()));
+  EXPECT_EQ(folder.exit_code, 2) << folder.output;
+  EXPECT_THAT(folder.output, HasSubstr("is a folder"));
+}
+
+TEST(BadInput, OneFrameRunSaysWhyThereIsNoAte) {
+  const Outcome r = cli(run_on(base_sequence(), "one_frame", "-n 1"));
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("ATE              not computed: 1 tracked pose (2 needed)"));
+}
+
+TEST(BadInput, OutputFolderThatCannotBeCreatedIsAnInputError) {
+  const fs::path file = out_dir("a_file");
+  std::ofstream(file) << "x";
+  const Outcome r = cli("run -q -d " + base_sequence().string() + " -o " + (file / "sub").string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("cannot create the output folder"));
+}
+
+TEST(BadInput, NegativeFrameCountIsRejected) {
+  const Outcome r = cli(run_on(base_sequence(), "negative_n", "-n -1"));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_THAT(r.output, HasSubstr("expected a whole number of frames"));
+}
+
+TEST(BadInput, AbsurdCoordinatesAndBoxValuesAreRejected) {
+  const fs::path dir = out_dir("absurd");
+  fs::create_directories(dir);
+  std::ofstream(dir / "est.txt") << "1.0 1e300 0 0 0 0 0 1\n2.0 0 0 0 0 0 0 1\n";
+  const Outcome eval = cli("eval --gt " + (base_sequence() / "groundtruth.txt").string() + " --est " +
+                           (dir / "est.txt").string());
+  EXPECT_EQ(eval.exit_code, 2) << eval.output;
+  EXPECT_THAT(eval.output, HasSubstr("not a camera position"));
+  const fs::path seq = copy_of_base("absurd_boxes");
+  append(seq / "boxes.txt", "1311870436.796000 person 0.9 1e300 10 10 10\n");
+  const Outcome boxes = cli(run_on(seq, "absurd_boxes", "--set semantic.detector=boxes"));
+  EXPECT_EQ(boxes.exit_code, 2) << boxes.output;
+  EXPECT_THAT(boxes.output, HasSubstr("out of range"));
+}
+
+TEST(BadInput, AnEarlierRunsOutputsAreClearedAndAConcurrentRunIsRefused) {
+  const fs::path out = out_dir("reused");
+  fs::create_directories(out);
+  std::ofstream(out / "report.html") << "old";
+  std::ofstream(out / "CameraTrajectory_aligned.txt") << "old";
+  std::ofstream(out / "notes.txt") << "mine";
+  // A run without ground truth leaves no aligned trajectory: the old one must not stay behind.
+  const fs::path seq = copy_of_base("no_gt");
+  fs::remove(seq / "groundtruth.txt");
+  const Outcome r = cli("run -q -d " + seq.string() + " -o " + out.string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_FALSE(fs::exists(out / "CameraTrajectory_aligned.txt"));
+  EXPECT_NE(slurp(out / "report.html"), "old");
+  EXPECT_EQ(slurp(out / "notes.txt"), "mine") << "files that are not ours stay";
+
+  const int fd = ::open((out / ".varslam.lock").c_str(), O_RDWR | O_CREAT, 0644);
+  ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);  // as a run in progress holds it
+  const Outcome second = cli("run -q -d " + seq.string() + " -o " + out.string());
+  ::close(fd);
+  EXPECT_EQ(second.exit_code, 2) << second.output;
+  EXPECT_THAT(second.output, HasSubstr("another varslam run is writing into this folder"));
+}
+
+TEST(BadInput, SigintStopsTheRunCleanlyAndKeepsWhatWasTracked) {
+  synth::SynthConfig cfg;
+  cfg.scenario = "static";
+  cfg.seconds = 6.0;
+  cfg.seed = 2;
+  const fs::path seq = slam::e2e::cached_sequence("cli_static_6s", cfg);
+  const fs::path out = out_dir("sigint");
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    const std::string log = out.string() + ".log";
+    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ::dup2(fd, 1);
+    ::dup2(fd, 2);
+    ::execl(kCli.c_str(), kCli.c_str(), "run", "-q", "--realtime", "--pace", "-d", seq.c_str(), "-o", out.c_str(),
+            static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(2500));  // past start-up, a few seconds into the sequence
+  const auto sent = std::chrono::steady_clock::now();
+  ::kill(pid, SIGINT);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  const double stop_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - sent).count();
+  ASSERT_TRUE(WIFEXITED(status)) << slurp(out.string() + ".log");
+  EXPECT_EQ(WEXITSTATUS(status), 130) << slurp(out.string() + ".log");
+  EXPECT_LT(stop_s, 2.0) << "stopping took " << stop_s << " s";
+  const std::string metrics = slurp(out / "metrics.json");
+  EXPECT_THAT(metrics, HasSubstr("\"status\": \"interrupted\""));
+  const std::string traj = slurp(out / "CameraTrajectory.txt");
+  const auto lines = std::count(traj.begin(), traj.end(), '\n');
+  EXPECT_GT(lines, 10);
+  EXPECT_LT(lines, 170) << "the whole sequence was run";
+}
+
+}  // namespace
+}  // namespace varslam
