@@ -98,7 +98,7 @@ inline constexpr KeySpec kKeys[] = {
     detail::real("depth.edge_ratio", 0.1, 0.0, 1.0, "keypoints on depth discontinuities keep no depth (colour and depth of real sensors are misregistered there); 0 = off"),
     detail::real("depth.disparity_weight", 10.0, 0.0, 1e4, "depth term of pose optimisation and BA: disparity bf/z with sigma 1/weight pixels; 0 = ORB-SLAM3's virtual-stereo residual"),
     detail::choice("depth.registration", "auto", "auto|off", "auto: check on 10 frames whether depth is registered to colour and warp it into the colour camera when it clearly is not"),
-    detail::optional_real("depth.camera_fx", 0.0, 1e5, "depth camera focal length x: when given, depth comes from this separate camera and is warped into the colour camera", "("),
+    detail::optional_real("depth.camera_fx", 0.0, 1e5, "depth camera focal length x: when given (> 0), depth comes from this separate camera and is warped into the colour camera; 0 = none"),
     detail::optional_real("depth.camera_fy", 0.0, 1e5, "depth camera focal length y (default: depth.camera_fx)", "("),
     detail::optional_real("depth.camera_cx", -1e5, 1e5, "depth camera principal point x (default: camera.cx)"),
     detail::optional_real("depth.camera_cy", -1e5, 1e5, "depth camera principal point y (default: camera.cy)"),
@@ -213,7 +213,7 @@ inline constexpr std::string_view kSections[] = {"camera",   "depth", "orb",    
 /// ORB-SLAM3 / ORB-SLAM2 keys that varslam reads nothing from: accepted in settings files, never an error.
 /// An entry ending in '.' covers every key with that prefix.
 inline constexpr std::string_view kIgnoredForeignKeys[] = {
-    "File.version", "Camera.type", "Camera.RGB", "Camera.newWidth", "Camera.newHeight", "Camera.bFishEye",
+    "File.version", "Camera.RGB", "Camera.newWidth", "Camera.newHeight", "Camera.bFishEye",
     "Stereo.T_c1_c2", "Tbc", "Viewer.", "System.", "IMU.", "Camera2.", "LoopClosing.", "Tracking.", "PointCloudMapping."};
 
 constexpr std::span<const KeySpec> all() { return kKeys; }

@@ -204,6 +204,16 @@ std::string suggestion(std::string_view name, bool section_only) {
   throw ConfigError(fmt::format("{}: unknown {} '{}'{}", loc, what, name, suggestion(name, section)));
 }
 
+// varslam models a pinhole camera at the image's own resolution; an ORB-SLAM file asking for anything else is
+// refused rather than read as a pinhole.
+void check_supported_camera(const std::string& key, const YAML::Node& value, const std::string& loc) {
+  const std::string v = value.IsScalar() ? value.Scalar() : std::string();
+  const bool ok = key == "Camera.type" ? (v == "PinHole" || v == "Rectified") : (as_number(value) == 1.0);
+  if (!ok)
+    throw ConfigError(fmt::format("{}: key '{}' is {}: varslam supports {} only", loc, key, show(value),
+                                  key == "Camera.type" ? "PinHole (or Rectified) cameras" : "Camera.imageScale 1"));
+}
+
 std::string location(const std::filesystem::path& file, const YAML::Node& node) {
   const std::string name = file.empty() ? std::string("<settings>") : file.string();
   const auto mark = node.Mark();
@@ -340,6 +350,10 @@ void check_settings_document(const YAML::Node& root, const std::filesystem::path
       continue;
     }
     if (is_ignored_foreign_key(top)) continue;
+    if (top == "Camera.type" || top == "Camera.imageScale") {  // ORB-SLAM keys whose other values we cannot honour
+      check_supported_camera(top, value, location(file, kv.first));
+      continue;
+    }
     if (top.find('.') != std::string::npos) unknown(location(file, kv.first), "key", top, false);
     if (!is_section(top)) {
       if (value.IsMap() || value.IsNull()) unknown(location(file, kv.first), "section", top, true);
@@ -471,6 +485,7 @@ std::string settings_reference_text() {
     out << fmt::format("  {:<28} {:<18} {:<28} {}\n", k.name, default_text(k), range_text(k), k.meaning);
     if (!k.aliases.empty()) out << fmt::format("  {:<28} also read as {}\n", "", k.aliases);
   }
+  out << "\nORB-SLAM keys accepted with one value: Camera.type (PinHole, Rectified), Camera.imageScale (1)";
   out << "\nORB-SLAM keys accepted and ignored:";
   for (std::string_view i : setting_keys::kIgnoredForeignKeys) out << ' ' << i << (i.back() == '.' ? "*" : "");
   out << "\n";
@@ -503,7 +518,9 @@ std::string settings_reference_markdown() {
     std::replace(range.begin(), range.end(), '|', '/');
     out << fmt::format("| `{}` | `{}` | {} | {} |\n", k.name, default_text(k), range, meaning);
   }
-  out << "\n## ORB-SLAM keys accepted and ignored\n\n";
+  out << "\n## ORB-SLAM keys accepted and ignored\n\n"
+         "`Camera.type` (`PinHole` or `Rectified`) and `Camera.imageScale` (`1`) are accepted with those values only: "
+         "varslam models a pinhole camera at the image's resolution. These are ignored:\n\n";
   for (std::string_view i : setting_keys::kIgnoredForeignKeys) out << "- `" << i << (i.back() == '.' ? "*" : "") << "`\n";
   return out.str();
 }

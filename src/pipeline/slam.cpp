@@ -11,6 +11,7 @@
 #include "core/error.hpp"
 #include "io/colour_registration.hpp"
 #include "io/depth_image.hpp"
+#include "io/settings_registry.hpp"
 #include "semantic/dynamic_keypoint_masker.hpp"
 
 namespace varslam {
@@ -79,7 +80,7 @@ RgbdFrame frame_from_images(const cv::Mat& bgr, const cv::Mat& depth, double tim
     f.bgr = bgr;
     cv::cvtColor(bgr, f.gray, cv::COLOR_BGR2GRAY);
   } else if (bgr.type() == CV_8UC1) {
-    f.gray = bgr;
+    f.gray = bgr.clone();  // kept for box propagation: must not follow a capture buffer the caller reuses
     cv::cvtColor(bgr, f.bgr, cv::COLOR_GRAY2BGR);
   } else {
     throw InputError("Slam::track: the colour image must be CV_8UC3 (BGR) or CV_8UC1");
@@ -90,6 +91,23 @@ RgbdFrame frame_from_images(const cv::Mat& bgr, const cv::Mat& depth, double tim
   else if (depth.type() == CV_32FC1) f.depth = depth;
   else throw InputError("Slam::track: the depth image must be CV_16UC1 (raw, depth.factor per metre) or CV_32FC1 (m)");
   return f;
+}
+
+// A decoded frame as the stages need it: gray and depth (metres) of the camera's size.
+void check_frame(const RgbdFrame& f, const PinholeCamera& cam) {
+  const auto fits = [&](const cv::Mat& m) { return m.cols == cam.width && m.rows == cam.height; };
+  if (f.gray.empty() || f.gray.type() != CV_8UC1 || !fits(f.gray))
+    throw InputError(fmt::format("Slam::track: frame {} needs a CV_8UC1 gray image of {}x{}", f.index, cam.width,
+                                 cam.height));
+  if (f.depth.empty() || f.depth.type() != CV_32FC1 || !fits(f.depth))
+    throw InputError(fmt::format("Slam::track: frame {} needs a CV_32FC1 depth image in metres of {}x{}", f.index,
+                                 cam.width, cam.height));
+}
+
+// Settings built in code (not loaded) get the same whole-document check a file does.
+const Settings& checked(const Settings& s) {
+  check_settings_document(s.root, s.source, s.overrides);
+  return s;
 }
 
 }  // namespace
@@ -116,7 +134,7 @@ class Slam::Relay final : public slam::SystemObserver {
 };
 
 Slam::Slam(const Settings& settings, SlamOptions options)
-    : settings_(settings),
+    : settings_(checked(settings)),
       cfg_(slam::slam_config_from(settings)),
       options_(std::move(options)),
       semantic_(semantic::semantic_settings(settings)),
@@ -147,7 +165,8 @@ void Slam::remove_observer(Observer& observer) {
 
 template <typename Event, typename Fn>
 void Slam::emit(const Event& e, Fn fn) {
-  for (Observer* o : observers_) (o->*fn)(e);
+  const std::vector<Observer*> observers = observers_;  // an observer may add or remove observers meanwhile
+  for (Observer* o : observers) (o->*fn)(e);
 }
 
 void Slam::calibrate_depth(std::span<const RgbdFrame> samples) {
@@ -186,6 +205,8 @@ void Slam::install_person_filter() {
 }
 
 std::function<void(RgbdFrame&)> Slam::frame_preparation() const {
+  if (!system_ && wants_depth_samples())
+    throw std::logic_error("Slam::frame_preparation: call calibrate_depth() first (depth.registration: auto)");
   if (!cfg_.tracking.depth_rig) return [](RgbdFrame& f) { f.depth_in_colour_frame = true; };
   return [rig = *cfg_.tracking.depth_rig, colour = settings_.camera](RgbdFrame& f) {
     if (f.depth_in_colour_frame) return;
@@ -201,6 +222,7 @@ FrameResult Slam::track(const cv::Mat& bgr, const cv::Mat& depth, double timesta
 
 FrameResult Slam::track(const RgbdFrame& input, const std::optional<Detections>& boxes) {
   if (finished_) throw std::logic_error("Slam::track after finish()");
+  check_frame(input, settings_.camera);
   if (!system_) start(std::span<const RgbdFrame>(&input, 1));
   RgbdFrame frame = input;
   if (!frame.depth_in_colour_frame) frame_preparation()(frame);
@@ -215,6 +237,7 @@ FrameResult Slam::track(const RgbdFrame& input, const std::optional<Detections>&
   }
 
   const slam::TrackOutcome out = system_->process(frame);
+  if (masker_) masker_->give_boxes(std::nullopt);  // unused (no keypoints reached the filter): not for the next frame
   FrameResult r;
   r.index = frames_++;
   r.timestamp = frame.timestamp;
@@ -258,7 +281,12 @@ void Slam::deliver_queued() {
 void Slam::finish() {
   if (finished_) return;
   finished_ = true;
-  if (system_) system_->finish();
+  try {
+    if (system_) system_->finish();
+  } catch (...) {
+    deliver_queued();  // what mapping did before the error still reaches the observers
+    throw;
+  }
   deliver_queued();
 }
 

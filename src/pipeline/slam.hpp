@@ -33,7 +33,8 @@ class DynamicKeypointMasker;
 
 struct SlamOptions {
   RunMode mode = RunMode::Deterministic;
-  /// A person detector of the caller's own, used instead of the one `semantic.detector` names.
+  /// A person detector of the caller's own, used instead of the one `semantic.detector` names. In real-time mode
+  /// with semantic.asynchronous it runs on the detector's thread.
   std::shared_ptr<semantic::Detector> detector;
 };
 
@@ -55,7 +56,7 @@ class Slam {
   Slam& operator=(const Slam&) = delete;
 
   /// Observers get every event from now on, in the order added. Not owned: each must outlive the pipeline or be
-  /// removed first.
+  /// removed first. An observer may add or remove observers from a callback, but not call track() or finish().
   void add_observer(Observer& observer);
   void remove_observer(Observer& observer);
 
@@ -73,7 +74,8 @@ class Slam {
   /// own detector (the person filter then uses them as they are).
   FrameResult track(const cv::Mat& bgr, const cv::Mat& depth, double timestamp,
                     const std::optional<Detections>& boxes = std::nullopt);
-  /// The same for a decoded frame (dataset readers: depth already in metres).
+  /// The same for a decoded frame (dataset readers): gray CV_8UC1 (bgr optional, for the detector) and depth
+  /// CV_32FC1 in metres, of the camera's size; InputError otherwise.
   FrameResult track(const RgbdFrame& frame, const std::optional<Detections>& boxes = std::nullopt);
 
   /// Finishes local mapping and loop closing so the map and trajectories are final; rethrows an error a worker

@@ -60,7 +60,10 @@ std::vector<fs::path> model_search_dirs(const fs::path& model_dir) {
   if (const char* env = std::getenv("VARSLAM_MODELS"); env && *env) candidates.emplace_back(env);
   candidates.emplace_back("models");
   candidates.emplace_back("../shared/models");
-  std::error_code exe_ec;
+#ifdef VARSLAM_MODELS_INSTALL_DIR
+  candidates.emplace_back(VARSLAM_MODELS_INSTALL_DIR);  // the install prefix's share/varslam/models
+#endif
+  std::error_code exe_ec;  // and next to an installed program moved elsewhere: <bin>/../share/varslam/models
   const fs::path exe = fs::read_symlink("/proc/self/exe", exe_ec);
   if (!exe_ec) candidates.push_back(exe.parent_path().parent_path() / "share" / "varslam" / "models");
   std::vector<fs::path> out;

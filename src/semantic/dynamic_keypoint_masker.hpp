@@ -38,7 +38,7 @@ class DynamicKeypointMasker {
 
   /// Boxes for the next frame processed, given by the caller (e.g. from its own detector): that frame uses them
   /// as they are, and the detector does not run on it.
-  void give_boxes(Detections boxes) { given_ = std::move(boxes); }
+  void give_boxes(std::optional<Detections> boxes) { given_ = std::move(boxes); }
 
   /// Blocks until the detector has finished every submitted frame.
   void wait_for_detector() { async_.wait_idle(); }

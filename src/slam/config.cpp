@@ -45,7 +45,7 @@ optim::KernelConfig read_kernel(const Settings& s, const std::string& section) {
 // depth.camera_fx. Its image size is the colour camera's (both 640x480 on a Kinect).
 std::optional<DepthCameraRig> read_depth_rig(const Settings& s) {
   const auto fx = setting_if_given(s, "depth.camera_fx");
-  if (!fx) return std::nullopt;
+  if (!fx || *fx == 0.0) return std::nullopt;
   DepthCameraRig rig;
   PinholeCamera& d = rig.depth;
   d.width = s.camera.width;

@@ -64,6 +64,7 @@ void LocalMapper::insert(const KeyFramePtr& kf) {
 }
 
 void LocalMapper::process_all() {
+  if (failed_) return;
   for (;;) {
     KeyFramePtr kf;
     {
@@ -72,8 +73,21 @@ void LocalMapper::process_all() {
       kf = queue_.front();
       queue_.pop_front();
     }
-    process(kf);
+    try {
+      process(kf);
+    } catch (...) {
+      fail(std::current_exception());
+      throw;
+    }
   }
+}
+
+void LocalMapper::fail(std::exception_ptr error) {
+  std::lock_guard lock(queue_mutex_);
+  failure_ = std::move(error);
+  failed_ = true;
+  queue_.clear();
+  busy_ = false;
 }
 
 void LocalMapper::start() {
@@ -84,7 +98,10 @@ void LocalMapper::start() {
 
 void LocalMapper::stop() {
   if (!thread_.joinable()) return;
-  stop_requested_ = true;
+  {
+    std::lock_guard lock(queue_mutex_);  // else the thread may test the flag, miss the notify and sleep forever
+    stop_requested_ = true;
+  }
   queue_cv_.notify_all();
   thread_.join();
 }
@@ -103,12 +120,7 @@ void LocalMapper::run() {
     try {
       process(kf);
     } catch (...) {
-      // Reaches the caller through failure() (System::process rethrows it); mapping stops here.
-      std::lock_guard lock(queue_mutex_);
-      failure_ = std::current_exception();
-      failed_ = true;
-      queue_.clear();
-      busy_ = false;
+      fail(std::current_exception());  // reaches the caller through failure(); mapping stops here
       return;
     }
     busy_ = false;

@@ -46,6 +46,8 @@ class LocalMapper final : public KeyframeSink {
 
  private:
   void run();
+  /// Records the error that stopped mapping (deterministic or real-time alike) and drops the queue.
+  void fail(std::exception_ptr error);
   void process(const KeyFramePtr& kf);
   void add_observations(const KeyFramePtr& kf);
   void cull_recent_points(const KeyFramePtr& kf);

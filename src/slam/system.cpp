@@ -22,6 +22,7 @@ System::~System() {
 }
 
 TrackOutcome System::process(const RgbdFrame& frame) {
+  // After a mapping error the map is no longer consistent: every later call reports that error.
   if (const auto failure = mapper_.failure()) std::rethrow_exception(failure);
   TrackOutcome out = tracker_.track(frame);
   if (mode_ == RunMode::Deterministic) mapper_.process_all();

@@ -146,7 +146,8 @@ TrackOutcome Tracker::track(const RgbdFrame& input) {
   out.state = state_;
   if (state_ == TrackState::Ok) out.live_T_wc = cur.T_cw.inverse();
   if (out.keyframe && cur.reference_kf) out.keyframe_id = cur.reference_kf->id();
-  out.relocalized = std::exchange(relocalized_, std::nullopt);
+  const std::optional<Relocalization> relocalized = std::exchange(relocalized_, std::nullopt);
+  if (state_ == TrackState::Ok && !out.new_segment) out.relocalized = relocalized;  // not when local-map tracking failed
   last_ = cur;
   last_is_keyframe_ = out.keyframe;
   out.timings.track_ms = ms_since(t_start);

@@ -127,6 +127,16 @@ TEST(SettingsRegistry, OrbSlamKeysWeDoNotUseAreAcceptedAndOthersAreErrors) {
               AllOf(HasSubstr("bad.yaml:5:"), HasSubstr("ORBextractor.nFeature")));
 }
 
+TEST(SettingsRegistry, OrbSlamCameraModelsWeCannotHonourAreRefused) {
+  TempDir dir;
+  const std::string cam = "Camera1.fx: 500\nCamera1.fy: 500\nCamera1.cx: 320\nCamera1.cy: 240\n";
+  EXPECT_NO_THROW(load_settings(dir.write("pin.yaml", cam + "Camera.type: \"PinHole\"\nCamera.imageScale: 1\n")));
+  EXPECT_THAT(config_error([&] { load_settings(dir.write("kb.yaml", cam + "Camera.type: \"KannalaBrandt8\"\n")); }),
+              AllOf(HasSubstr("kb.yaml:5:"), HasSubstr("PinHole")));
+  EXPECT_THAT(config_error([&] { load_settings(dir.write("sc.yaml", cam + "Camera.imageScale: 0.5\n")); }),
+              HasSubstr("Camera.imageScale 1"));
+}
+
 TEST(SettingsRegistry, NearestKeySuggestsTyposOnly) {
   EXPECT_EQ(nearest_key("tracking.kernl"), "tracking.kernel");
   EXPECT_EQ(nearest_key("semantic.detecter"), "semantic.detector");

@@ -168,5 +168,47 @@ TEST(Pipeline, ImagesOfTheWrongSizeOrTypeAreInputErrors) {
   EXPECT_EQ(slam.summary().frames, 1u);
 }
 
+TEST(Pipeline, SettingsBuiltInCodeAreCheckedAndMisuseIsNamed) {
+  Settings typo = default_settings();
+  typo.root = YAML::Load("tracking: {kernl: huber}");
+  EXPECT_THROW(Slam{typo}, ConfigError);
+
+  Settings s = default_settings();
+  apply_setting_overrides(s, {"semantic.detector=none"});
+  Slam slam(s);
+  EXPECT_THROW(slam.frame_preparation(), std::logic_error);  // depth registration is not decided yet
+  slam.calibrate_depth({});
+  EXPECT_NO_THROW(slam.frame_preparation());
+  RgbdFrame bad;
+  bad.gray = cv::Mat(480, 640, CV_8UC1, cv::Scalar(0));
+  bad.depth = cv::Mat(480, 640, CV_16UC1, cv::Scalar(0));  // raw depth where metres are due
+  EXPECT_THROW(slam.track(bad), InputError);
+}
+
+// An observer may leave from inside its own callback.
+TEST(Pipeline, ObserverCanRemoveItselfDuringACallback) {
+  struct OneShot final : Observer {
+    Slam* slam = nullptr;
+    int calls = 0;
+    void on_frame(const FrameResult&) override {
+      ++calls;
+      slam->remove_observer(*this);
+    }
+  };
+  Settings s = default_settings();
+  apply_setting_overrides(s, {"semantic.detector=none"});
+  Slam slam(s);
+  OneShot once;
+  once.slam = &slam;
+  Tally tally;
+  slam.add_observer(once);
+  slam.add_observer(tally);
+  const cv::Mat bgr(480, 640, CV_8UC3, cv::Scalar::all(100)), depth(480, 640, CV_16UC1, cv::Scalar::all(5000));
+  slam.track(bgr, depth, 0.0);
+  slam.track(bgr, depth, 0.1);
+  EXPECT_EQ(once.calls, 1);
+  EXPECT_EQ(tally.frames, 2);
+}
+
 }  // namespace
 }  // namespace varslam

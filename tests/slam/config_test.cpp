@@ -105,6 +105,13 @@ TEST(SlamConfig, DepthRegistrationIsAutoOrOff) {
   EXPECT_NE(msg.find("depth.registration"), std::string::npos) << msg;
 }
 
+TEST(SlamConfig, DepthCameraFxZeroMeansRegisteredDepth) {  // as the settings files before the registry wrote it
+  EXPECT_FALSE(slam_config_from(load_settings(write_settings("cfg_rig0.yaml", "depth.camera_fx: 0\n")))
+                   .tracking.depth_rig);
+  EXPECT_TRUE(slam_config_from(load_settings(write_settings("cfg_rig.yaml", "")))
+                  .tracking.estimate_registration);
+}
+
 TEST(SlamConfig, RejectsNonPositiveTau) {
   EXPECT_THROW(slam_config_from(load_settings(write_settings("cfg_tau.yaml", "mapping: {tau: -1}\n"))), ConfigError);
 }

@@ -11,7 +11,11 @@
 namespace varslam::slam {
 namespace {
 
-TEST(System, MappingThreadErrorReachesTheCaller) {
+class SystemError : public ::testing::TestWithParam<RunMode> {};
+
+// In either mode the error reaches the caller with its message, and every later frame reports it again: the map
+// is no longer consistent.
+TEST_P(SystemError, MappingErrorReachesTheCallerAndStopsMapping) {
   synth::SynthConfig sc;
   sc.scenario = "static";
   sc.seconds = 4.0;
@@ -26,15 +30,25 @@ TEST(System, MappingThreadErrorReachesTheCaller) {
     if (++local_bas == 2) throw std::runtime_error("local BA exploded");
   };
   try {
-    System system(cfg, settings.camera, settings.close_depth_m(), RunMode::RealTime);
-    for (std::size_t i = 0; i < ds->size(); ++i) system.process(ds->load(i));
-    system.finish();
+    System system(cfg, settings.camera, settings.close_depth_m(), GetParam());
+    std::size_t i = 0;
+    try {
+      for (; i < ds->size(); ++i) system.process(ds->load(i));
+      system.finish();
+    } catch (const std::runtime_error& e) {
+      message = e.what();
+    }
+    ASSERT_LT(i + 1, ds->size());
+    EXPECT_THROW(system.process(ds->load(i + 1)), std::runtime_error);
+    EXPECT_THROW(system.finish(), std::runtime_error);
   } catch (const std::runtime_error& e) {
-    message = e.what();
+    ADD_FAILURE() << "unexpected: " << e.what();
   }
   EXPECT_EQ(message, "local BA exploded");
   EXPECT_EQ(local_bas, 2);  // mapping stopped at the error
 }
+
+INSTANTIATE_TEST_SUITE_P(BothModes, SystemError, ::testing::Values(RunMode::Deterministic, RunMode::RealTime));
 
 }  // namespace
 }  // namespace varslam::slam
