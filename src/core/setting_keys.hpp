@@ -4,6 +4,7 @@
 // config structs' defaults all come from this table. Pure data (no YAML), so every module can take its defaults
 // from here at compile time: `int gap = setting_keys::int_default("tracking.close_keyframe_gap");` fails to
 // compile when the key is not declared.
+#include <iterator>
 #include <limits>
 #include <map>
 #include <span>
@@ -218,36 +219,43 @@ inline constexpr std::string_view kIgnoredForeignKeys[] = {
 
 constexpr std::span<const KeySpec> all() { return kKeys; }
 
+/// Position of the key in kKeys; std::size(kKeys) when it is not declared.
+constexpr std::size_t key_index(std::string_view name) {
+  for (std::size_t i = 0; i < std::size(kKeys); ++i)
+    if (kKeys[i].name == name) return i;
+  return std::size(kKeys);
+}
+
 /// The key's declaration; nullptr when it is not declared.
 constexpr const KeySpec* find(std::string_view name) {
-  for (const KeySpec& k : kKeys)
-    if (k.name == name) return &k;
-  return nullptr;
+  const std::size_t i = key_index(name);
+  return i == std::size(kKeys) ? nullptr : &kKeys[i];
 }
 
 /// Compile-time defaults for the config structs: a name that is not declared, or of another type, does not compile.
-consteval const KeySpec& spec(std::string_view name) {
-  const KeySpec* k = find(name);
-  if (!k) throw "setting_keys: key not declared in kKeys";
-  return *k;
+/// (By value and by index: GCC's sanitizer instrumentation rejects pointer tests in constant evaluation.)
+consteval KeySpec spec(std::string_view name) {
+  const std::size_t i = key_index(name);
+  if (i == std::size(kKeys)) throw "setting_keys: key not declared in kKeys";
+  return kKeys[i];
 }
 consteval int int_default(std::string_view name) {
-  const KeySpec& k = spec(name);
+  const KeySpec k = spec(name);
   if (k.type != KeyType::Int) throw "setting_keys: not an integer key";
   return static_cast<int>(k.number);
 }
 consteval double real_default(std::string_view name) {
-  const KeySpec& k = spec(name);
+  const KeySpec k = spec(name);
   if (k.type != KeyType::Real || !k.has_default) throw "setting_keys: not a real key with a default";
   return k.number;
 }
 consteval bool bool_default(std::string_view name) {
-  const KeySpec& k = spec(name);
+  const KeySpec k = spec(name);
   if (k.type != KeyType::Bool) throw "setting_keys: not a boolean key";
   return k.number != 0.0;
 }
 consteval std::string_view text_default(std::string_view name) {
-  const KeySpec& k = spec(name);
+  const KeySpec k = spec(name);
   if (k.type == KeyType::Int || k.type == KeyType::Real || k.type == KeyType::Bool)
     throw "setting_keys: not a text key";
   return k.text;

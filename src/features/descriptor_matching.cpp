@@ -10,8 +10,10 @@
 #include <string>
 
 // The build targets baseline x86-64, where std::popcount is a slow bit-twiddling sequence. On GCC/x86-64
-// the hot functions get a second, POPCNT-instruction version, chosen once at load time by the CPU.
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+// the hot functions get a second, POPCNT-instruction version, chosen once at load time by the CPU. Not under
+// ThreadSanitizer or AddressSanitizer: their instrumented load-time resolver runs before the sanitizer starts.
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && !defined(__SANITIZE_THREAD__) && \
+    !defined(__SANITIZE_ADDRESS__)
 #define VARSLAM_POPCNT_CLONES __attribute__((target_clones("popcnt", "default")))
 #else
 #define VARSLAM_POPCNT_CLONES

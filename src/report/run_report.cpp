@@ -9,6 +9,7 @@
 #include "core/error.hpp"
 #include "eval/ate.hpp"
 #include "eval/eval_report.hpp"
+#include "io/atomic_file.hpp"
 #include "io/trajectory_io.hpp"
 #include "report/html.hpp"
 
@@ -263,10 +264,7 @@ std::string render_run_report(const RunReportInputs& in) {
 
 void write_run_report(const std::filesystem::path& run_dir, const std::filesystem::path& sequence_dir,
                       const std::filesystem::path& out_html) {
-  const std::string html = render_run_report(load_run_report_inputs(run_dir, sequence_dir));
-  std::ofstream out(out_html);
-  out << html;
-  if (!out) throw InputError(out_html.string() + ": cannot write the report");
+  write_file_atomically(out_html, render_run_report(load_run_report_inputs(run_dir, sequence_dir)), "report");
 }
 
 }  // namespace varslam::report

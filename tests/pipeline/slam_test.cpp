@@ -7,6 +7,7 @@
 
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 #include "core/error.hpp"
 #include "io/boxes_io.hpp"
@@ -183,6 +184,34 @@ TEST(Pipeline, SettingsBuiltInCodeAreCheckedAndMisuseIsNamed) {
   bad.gray = cv::Mat(480, 640, CV_8UC1, cv::Scalar(0));
   bad.depth = cv::Mat(480, 640, CV_16UC1, cv::Scalar(0));  // raw depth where metres are due
   EXPECT_THROW(slam.track(bad), InputError);
+}
+
+// Real-time mode: mapping and the detector on their own threads, every event still on the caller's thread.
+TEST(Pipeline, RealTimeEventsArriveOnTheCallersThread) {
+  const fs::path seq = walking_sequence();
+  Settings settings = settings_for_dataset(seq, std::nullopt);
+  apply_setting_overrides(settings, {"semantic.detector=boxes", "semantic.asynchronous=true"});
+  struct ThreadCheck final : Observer {
+    std::thread::id caller = std::this_thread::get_id();
+    int elsewhere = 0, frames = 0, mapped = 0, detections = 0;
+    void note() { elsewhere += std::this_thread::get_id() != caller; }
+    void on_frame(const FrameResult&) override { note(), ++frames; }
+    void on_detection(const DetectionEvent&) override { note(), ++detections; }
+    void on_keyframe_mapped(const slam::KeyframeMapped&) override { note(), ++mapped; }
+    void on_loop_search(const slam::LoopSearch&) override { note(); }
+  } check;
+  const Images im = read_images(seq, settings, 60);
+  Slam slam(settings, SlamOptions{RunMode::RealTime, nullptr});
+  slam.add_observer(check);
+  std::size_t tracked = 0;
+  for (std::size_t i = 0; i < im.bgr.size(); ++i) tracked += slam.track(im.bgr[i], im.depth[i], im.stamps[i]).T_wc.has_value();
+  slam.finish();
+  EXPECT_EQ(check.elsewhere, 0);
+  EXPECT_EQ(check.frames, 60);
+  EXPECT_EQ(check.detections, 60);
+  EXPECT_GT(check.mapped, 1);
+  EXPECT_GE(tracked, 55u);
+  EXPECT_GE(static_cast<std::size_t>(check.mapped), slam.summary().keyframes) << "every keyframe mapped by finish()";
 }
 
 // An observer may leave from inside its own callback.

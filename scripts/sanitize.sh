@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# The sanitizer stage of the test suite (scripts/run_tests.sh runs it after the main suite):
+#  - AddressSanitizer + UndefinedBehaviorSanitizer (with the leak checker) on the unit and short end-to-end tests;
+#  - ThreadSanitizer on the tests that run threads (real-time pipeline, mapping errors, async detection).
+# Each in its own build tree at -O1 (build-asan, build-tsan; ccache when present). Any report fails the stage.
+# Suppressions, third-party code only: .ci/tsan.supp.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+JOBS=$(nproc 2>/dev/null || echo 2)
+root=$(pwd)
+export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$root}
+
+configure() {  # build dir, sanitizer flags
+  cmake -S . -B "$1" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g -fno-omit-frame-pointer" \
+    -DCMAKE_CXX_FLAGS="$2" -DCMAKE_EXE_LINKER_FLAGS="$2" -DVARSLAM_BUILD_BENCH=OFF \
+    -DCMAKE_GTEST_DISCOVER_TESTS_DISCOVERY_MODE=PRE_TEST >/dev/null
+}
+
+# Kernels with many random mmap bits place ThreadSanitizer's shadow memory badly: run without address
+# randomisation where setarch can.
+norandom=()
+if setarch "$(uname -m)" -R true 2>/dev/null; then norandom=(setarch "$(uname -m)" -R); fi
+
+echo "[sanitize] AddressSanitizer + UndefinedBehaviorSanitizer"
+configure build-asan "-fsanitize=address,undefined -fno-sanitize-recover=undefined"
+asan_tests=(test_core test_robust test_io test_features test_optim test_semantic test_slam test_pipeline test_eval)
+cmake --build build-asan -j"$JOBS" --target "${asan_tests[@]}"
+export ASAN_OPTIONS="detect_leaks=1:abort_on_error=0:halt_on_error=1"
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+for t in "${asan_tests[@]}"; do
+  echo "[sanitize] asan+ubsan $t"
+  (cd build-asan && "${norandom[@]}" "./$t" --gtest_brief=1)
+done
+
+echo "[sanitize] ThreadSanitizer"
+configure build-tsan "-fsanitize=thread"
+cmake --build build-tsan -j"$JOBS" --target test_pipeline test_slam test_semantic
+export TSAN_OPTIONS="suppressions=$root/.ci/tsan.supp:halt_on_error=1:second_deadlock_stack=1"
+(cd build-tsan && "${norandom[@]}" ./test_pipeline --gtest_brief=1)
+(cd build-tsan && "${norandom[@]}" ./test_slam --gtest_brief=1 \
+  --gtest_filter='*SystemError*:EndToEnd.RealTimeModeTracksTheSameSequence')
+(cd build-tsan && "${norandom[@]}" ./test_semantic --gtest_brief=1 --gtest_filter='AsyncDetector.*')
+echo "[sanitize] no reports"
