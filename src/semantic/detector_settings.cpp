@@ -11,19 +11,21 @@ namespace varslam::semantic {
 namespace {
 namespace fs = std::filesystem;
 
-// Relative paths are relative to the settings file, if that makes them exist; else kept for the model search.
-// `dataset_first`: a data file of the dataset (boxes.txt) is looked for in the dataset's folder first.
+// A relative path is looked up beside the settings file, then as given (from the current folder); `dataset_first`:
+// a data file of the dataset (boxes.txt) is looked for in the dataset's folder before both. When none exists, it
+// stays as given (the model search and the error messages take it from there), a dataset file in the dataset.
 fs::path read_path(const Settings& s, const char* key, bool dataset_first = false) {
   const std::string text = setting<std::string>(s, key);
   if (text.empty()) return {};
   const fs::path p(text);
   if (!p.is_relative()) return p;
   std::error_code ec;
-  std::vector<fs::path> bases;
-  if (dataset_first && !s.dataset_dir.empty()) bases.push_back(s.dataset_dir);
-  if (!s.source.empty()) bases.push_back(s.source.parent_path());
-  for (const fs::path& base : bases)
-    if (fs::exists(base / p, ec)) return base / p;
+  std::vector<fs::path> candidates;
+  if (dataset_first && !s.dataset_dir.empty()) candidates.push_back(s.dataset_dir / p);
+  if (!s.source.empty()) candidates.push_back(s.source.parent_path() / p);
+  candidates.push_back(p);
+  for (const fs::path& c : candidates)
+    if (fs::exists(c, ec)) return c;
   return dataset_first && !s.dataset_dir.empty() ? s.dataset_dir / p : p;
 }
 

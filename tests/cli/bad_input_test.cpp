@@ -255,5 +255,17 @@ TEST(BadInput, SigintStopsTheRunCleanlyAndKeepsWhatWasTracked) {
   EXPECT_LT(lines, 170) << "the whole sequence was run";
 }
 
+// README's command 1 runs `varslam demo` from the checkout with a relative --out: its person boxes must be found.
+TEST(Demo, RunsFromARelativeFolderWithThePersonFilter) {
+  const fs::path dir = out_dir("demo_cwd");
+  fs::create_directories(dir);
+  const std::string cmd = "cd " + dir.string() + " && " + kCli + " demo --seconds 1 --out out/demo > demo.log 2>&1";
+  const int status = std::system(cmd.c_str());
+  const std::string log = slurp(dir / "demo.log");
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << log;
+  EXPECT_THAT(log, HasSubstr("ATE              rmse"));
+  EXPECT_THAT(slurp(dir / "out/demo/run/metrics.json"), HasSubstr("\"detector\": \"boxes(boxes.txt)\""));
+}
+
 }  // namespace
 }  // namespace varslam
