@@ -226,6 +226,17 @@ constexpr std::size_t key_index(std::string_view name) {
   return std::size(kKeys);
 }
 
+/// The same for `section` + "." + `key` (a stage's keys, looked up by section).
+constexpr std::size_t key_index(std::string_view section, std::string_view key) {
+  for (std::size_t i = 0; i < std::size(kKeys); ++i) {
+    const std::string_view n = kKeys[i].name;
+    if (n.size() == section.size() + 1 + key.size() && n.substr(0, section.size()) == section &&
+        n[section.size()] == '.' && n.substr(section.size() + 1) == key)
+      return i;
+  }
+  return std::size(kKeys);
+}
+
 /// The key's declaration; nullptr when it is not declared.
 constexpr const KeySpec* find(std::string_view name) {
   const std::size_t i = key_index(name);

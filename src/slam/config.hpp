@@ -22,31 +22,22 @@ constexpr optim::KernelType kernel_type_named(std::string_view name) {
   return optim::KernelType::Huber;
 }
 
-/// The registry's defaults of the kernel keys of tracking (pose-only optimisation) and mapping (Local BA).
-inline constexpr optim::KernelConfig kTrackingKernelDefaults = [] {
+/// The registry's defaults of a stage's kernel keys (`tracking` for pose-only optimisation, `mapping` for Local
+/// BA); a key missing from the table does not compile (its index runs past the table).
+consteval optim::KernelConfig kernel_defaults(std::string_view section) {
+  const auto key = [section](std::string_view name) { return setting_keys::kKeys[setting_keys::key_index(section, name)]; };
   optim::KernelConfig k;
-  k.type = kernel_type_named(setting_keys::text_default("tracking.kernel"));
-  k.barron_alpha = setting_keys::real_default("tracking.barron_alpha");
-  k.barron_c = setting_keys::real_default("tracking.barron_c");
-  k.tau = setting_keys::real_default("tracking.tau");
-  k.alpha_max = setting_keys::real_default("tracking.alpha_max");
-  k.fit = setting_keys::text_default("tracking.alpha_fit") == "norm" ? robust::AlphaFit::ResidualNorm
-                                                                     : robust::AlphaFit::PerComponent;
-  k.chi2_gates = setting_keys::bool_default("tracking.chi2_gates");
+  k.type = kernel_type_named(key("kernel").text);
+  k.barron_alpha = key("barron_alpha").number;
+  k.barron_c = key("barron_c").number;
+  k.tau = key("tau").number;
+  k.alpha_max = key("alpha_max").number;
+  k.fit = key("alpha_fit").text == "norm" ? robust::AlphaFit::ResidualNorm : robust::AlphaFit::PerComponent;
+  k.chi2_gates = key("chi2_gates").number != 0.0;
   return k;
-}();
-inline constexpr optim::KernelConfig kMappingKernelDefaults = [] {
-  optim::KernelConfig k;
-  k.type = kernel_type_named(setting_keys::text_default("mapping.kernel"));
-  k.barron_alpha = setting_keys::real_default("mapping.barron_alpha");
-  k.barron_c = setting_keys::real_default("mapping.barron_c");
-  k.tau = setting_keys::real_default("mapping.tau");
-  k.alpha_max = setting_keys::real_default("mapping.alpha_max");
-  k.fit = setting_keys::text_default("mapping.alpha_fit") == "norm" ? robust::AlphaFit::ResidualNorm
-                                                                    : robust::AlphaFit::PerComponent;
-  k.chi2_gates = setting_keys::bool_default("mapping.chi2_gates");
-  return k;
-}();
+}
+inline constexpr optim::KernelConfig kTrackingKernelDefaults = kernel_defaults("tracking");
+inline constexpr optim::KernelConfig kMappingKernelDefaults = kernel_defaults("mapping");
 
 // Each field's meaning, range and default are in the settings registry (core/setting_keys.hpp, docs/settings.md)
 // under the key it is read from (slam_config_from); what is said here is only what the registry cannot say.

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "io/config_error.hpp"
 #include "io/temp_dir.hpp"
 
 namespace varslam {
@@ -16,18 +17,9 @@ namespace {
 
 using ::testing::AllOf;
 using ::testing::HasSubstr;
+using varslam::testing::config_error;
 using varslam::testing::TempDir;
 
-template <typename Fn>
-std::string config_error(Fn&& fn) {
-  try {
-    fn();
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected a ConfigError";
-  return {};
-}
 
 const std::string kCamera =
     "camera: {fx: 500, fy: 500, cx: 320, cy: 240, width: 640, height: 480, fps: 30, baseline: 0.08}\n"

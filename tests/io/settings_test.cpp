@@ -5,6 +5,7 @@
 
 #include "core/error.hpp"
 #include "io/settings_registry.hpp"
+#include "io/config_error.hpp"
 #include "io/temp_dir.hpp"
 
 namespace varslam {
@@ -12,19 +13,9 @@ namespace {
 
 using ::testing::AllOf;
 using ::testing::HasSubstr;
+using varslam::testing::config_error;
 using varslam::testing::TempDir;
 
-// Runs fn, expects a ConfigError, returns its message.
-template <typename Fn>
-std::string config_error(Fn&& fn) {
-  try {
-    fn();
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected a ConfigError";
-  return {};
-}
 
 const char* kOurs = R"(camera:
   fx: 500.5
