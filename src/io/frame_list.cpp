@@ -71,12 +71,13 @@ std::vector<FramePair> associate_frames(const std::vector<ListEntry>& rgb, const
     double dt;
     std::size_t r, d;
   };
-  // Sorted lists: the depth window of each rgb stamp is found with a moving lower bound.
+  // Sorted lists: the depth window of each rgb stamp is found with a moving lower bound. The window is tested
+  // on differences, not on t +- max_dt, which rounds back to t for large stamps.
   std::vector<Candidate> candidates;
   std::size_t lo = 0;
   for (std::size_t r = 0; r < rgb.size(); ++r) {
-    while (lo < depth.size() && depth[lo].timestamp <= rgb[r].timestamp - max_dt) ++lo;
-    for (std::size_t d = lo; d < depth.size() && depth[d].timestamp < rgb[r].timestamp + max_dt; ++d)
+    while (lo < depth.size() && rgb[r].timestamp - depth[lo].timestamp >= max_dt) ++lo;
+    for (std::size_t d = lo; d < depth.size() && depth[d].timestamp - rgb[r].timestamp < max_dt; ++d)
       candidates.push_back({std::abs(rgb[r].timestamp - depth[d].timestamp), r, d});
   }
   std::stable_sort(candidates.begin(), candidates.end(),

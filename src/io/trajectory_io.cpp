@@ -16,10 +16,6 @@
 
 namespace varslam {
 namespace {
-
-}  // namespace
-
-namespace {
 // Beyond this a coordinate is garbage (and squared in the ATE it would overflow), whatever the unit.
 constexpr double kMaxCoordinate = 1e6;
 }  // namespace

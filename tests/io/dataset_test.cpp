@@ -121,6 +121,13 @@ TEST(FrameList, GreedyBySmallestDifferenceUsesEachDepthOnce) {
   EXPECT_DOUBLE_EQ(single[0].rgb.timestamp, 1.010);
 }
 
+TEST(FrameList, LargeStampsStillPairWithinTolerance) {
+  // At 1e15 s a double's step is 0.125 s, so t + 0.02 == t: the window must be tested on differences.
+  const auto pairs = associate_frames(entries({1e15, 1e15 + 1}), entries({1e15, 1e15 + 1}));
+  ASSERT_EQ(pairs.size(), 2u);
+  EXPECT_EQ(pairs[1].depth.timestamp, 1e15 + 1);
+}
+
 TEST(FrameList, ListErrorsNameFileAndLine) {
   TempDir dir;
   struct Case {

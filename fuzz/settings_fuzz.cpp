@@ -1,0 +1,33 @@
+// Settings files, both layouts (ours and ORB-SLAM's, with or without OpenCV's
+// %YAML:1.0 header): a file is read or refused with InputError; what is read
+// writes back out and reads again to the same values.
+#include <cmath>
+
+#include "core/error.hpp"
+#include "fuzz_input.hpp"
+#include "io/settings.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data,
+                                      std::size_t size) {
+  using namespace varslam;
+  const auto file = fuzz::write_input("settings.yaml", data, size);
+  Settings s;
+  try {
+    s = load_settings(file);
+  } catch (const InputError &) {
+    return 0;
+  }
+  VARSLAM_FUZZ_EXPECT(std::isfinite(s.camera.fx) && s.camera.fx > 0);
+  VARSLAM_FUZZ_EXPECT(s.camera.width > 0 && s.camera.height > 0);
+  VARSLAM_FUZZ_EXPECT(std::isfinite(s.depth_factor) && s.depth_factor > 0);
+  VARSLAM_FUZZ_EXPECT(s.orb.n_features > 0 && s.orb.n_levels > 0);
+
+  const auto again = fuzz::scratch_dir() / "settings_again.yaml";
+  save_settings(s, again);
+  const Settings t = load_settings(again);
+  VARSLAM_FUZZ_EXPECT(t.camera.fx == s.camera.fx &&
+                      t.camera.width == s.camera.width);
+  VARSLAM_FUZZ_EXPECT(t.depth_factor == s.depth_factor &&
+                      t.orb.n_features == s.orb.n_features);
+  return 0;
+}
