@@ -99,10 +99,16 @@ def stale_after_gtless(binary, base, work, o):
 
 
 def sigint(binary, base, work, o):
-    p = subprocess.Popen([binary, "run", "-q", "-d", base, "-o", o], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    # A shell's background job inherits SIGINT ignored: give the child the default, as a terminal would.
+    p = subprocess.Popen([binary, "run", "-q", "-d", base, "-o", o], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                         text=True, preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     time.sleep(2.0)
     p.send_signal(signal.SIGINT)
-    out, _ = p.communicate(timeout=30)
+    try:
+        out, _ = p.communicate(timeout=30)
+    except subprocess.TimeoutExpired:
+        p.kill()
+        return "-", "did not stop within 30 s of SIGINT"
     traj = Path(o) / "CameraTrajectory.txt"
     return p.returncode, (explain(out) + f" | CameraTrajectory.txt {'written' if traj.exists() else 'missing'}")
 
@@ -117,6 +123,7 @@ def concurrent(binary, base, work, o):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--work", default="/tmp/varslam_bad_input")
+    ap.add_argument("--only", nargs="*", help="case names to run (default: all)")
     ap.add_argument("binaries", nargs="+")
     a = ap.parse_args()
     work = Path(a.work); work.mkdir(parents=True, exist_ok=True)
@@ -125,7 +132,10 @@ def main():
         subprocess.run([a.binaries[-1], "synth", "--scenario", "walking", "--seconds", "3", "--out", base, "--no-preview"],
                        check=True, capture_output=True)
     rows = []
+    a.only = set(a.only or [])
     for name, desc, argv_fn, _ in cases(base, work):
+        if a.only and name not in a.only:
+            continue
         row = [name, desc]
         for i, b in enumerate(a.binaries):
             o = work / f"out_{i}_{name}"
@@ -137,6 +147,8 @@ def main():
     for name, desc, fn in (("stale_out", "ground-truth-less run into an earlier run's --out", stale_after_gtless),
                            ("sigint", "SIGINT 2 s into a run", sigint),
                            ("concurrent_out", "two concurrent runs into one --out", concurrent)):
+        if a.only and name not in a.only:
+            continue
         row = [name, desc]
         for i, b in enumerate(a.binaries):
             o = work / f"out_{i}_{name}"

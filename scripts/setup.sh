@@ -2,7 +2,7 @@
 # Installs the Debian packages varslam builds and tests with. Idempotent: skips apt when all are present.
 set -euo pipefail
 PKGS=(build-essential cmake pkg-config ccache libopencv-dev libeigen3-dev libceres-dev libyaml-cpp-dev
-      libcli11-dev libfmt-dev libspdlog-dev nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev
+      libcli11-dev libfmt-dev libspdlog-dev nlohmann-json3-dev zlib1g-dev libgtest-dev libgmock-dev libbenchmark-dev
       opencv-doc)
 missing=()
 for p in "${PKGS[@]}"; do

@@ -39,6 +39,9 @@ void print_run_summary(const run::RunSummary& s) {
     fmt::print("ATE              {}\n", s.ate_note);
   else
     fmt::print("ATE              (no ground truth)\n");
+  if (s.ate_map_frame_rmse)
+    fmt::print("ATE in map frame rmse {:.2f} cm, max {:.2f} cm (the loaded map's alignment to ground truth)\n",
+               *s.ate_map_frame_rmse * 100.0, *s.ate_map_frame_max * 100.0);
   fmt::print("trajectory       {}\n", (s.out_dir / "CameraTrajectory.txt").string());
   fmt::print("metrics          {}\n", (s.out_dir / "metrics.json").string());
   fmt::print("map              {}\n", (s.out_dir / "map.ply").string());

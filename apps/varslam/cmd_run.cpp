@@ -6,6 +6,7 @@
 #include <atomic>
 
 #include "cli_common.hpp"
+#include "core/error.hpp"
 #include "commands.hpp"
 #include "io/dataset.hpp"
 
@@ -39,8 +40,8 @@ const CLI::Validator kCount(
 
 void add_run_command(CLI::App& app) {
   struct Opts {
-    std::string dataset, settings, out = "out/run", groundtruth;
-    bool realtime = false, pace = false, quiet = false;
+    std::string dataset, settings, out = "out/run", groundtruth, save_map, load_map;
+    bool realtime = false, pace = false, quiet = false, localization_only = false;
     std::size_t first = 0, max_frames = SIZE_MAX;
     double min_tracked_share = 0.5;
     std::vector<std::string> overrides;
@@ -60,6 +61,10 @@ void add_run_command(CLI::App& app) {
                   "A run tracking a smaller share of its frames fails (exit 4); 0 accepts any run")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--save-map", o->save_map, "Write the final map here (docs/map_format.md)");
+  cmd->add_option("--load-map", o->load_map, "Start from this saved map: the first frames relocalize in it");
+  cmd->add_flag("--localization-only", o->localization_only,
+                "With --load-map: track in the loaded map without extending it (no keyframes, no points)");
   cmd->add_option("--set", o->overrides, "Override a setting: section.key=value (repeatable)");
   cmd->add_flag("--quiet,-q", o->quiet, "No progress line");
   cmd->add_option("--debug-frames", o->debug_frames,
@@ -80,6 +85,11 @@ void add_run_command(CLI::App& app) {
     ro.debug_frames.insert(o->debug_frames.begin(), o->debug_frames.end());
     if (!o->groundtruth.empty()) ro.groundtruth = o->groundtruth;
     ro.min_tracked_share = o->min_tracked_share;
+    if (!o->save_map.empty()) ro.save_map = o->save_map;
+    if (!o->load_map.empty()) ro.load_map = o->load_map;
+    if (o->localization_only && !ro.load_map)
+      throw InputError("--localization-only needs a map to localize in: give --load-map FILE");
+    ro.localization_only = o->localization_only;
     ro.stop = &g_stop_requested;
     stop_cleanly_on_signals();
     const run::RunSummary s = run::run_slam(*dataset, settings, ro, o->out);

@@ -176,6 +176,8 @@ inline constexpr KeySpec kKeys[] = {
     detail::integer("relocalization.min_score", 25, 1, 256, "signature matches (of 256) for a candidate keyframe"),
     detail::integer("relocalization.candidates", 5, 1, 100, "candidates tried per lost frame"),
     detail::integer("relocalization.min_inliers", 30, 3, 100000, "pose inliers against the candidate keyframe"),
+    detail::integer("relocalization.loaded_map_patience", 90, 1, 1000000,
+                    "frames a run started on a loaded map tries to relocalize in it before starting a new segment"),
 
     // semantic: the person detector and the depth-aware keypoint filter.
     detail::choice("semantic.detector", "auto", "auto|yolo|boxes|hog|none", "person detector: auto (yolo when its model is found, else none, said once), yolo (OpenCV dnn), boxes (a boxes file), hog, none (no person filter)"),

@@ -25,7 +25,7 @@ AteResult evaluate_ate(const Trajectory& gt, const Trajectory& est, const AteOpt
   }
 
   AteResult r;
-  r.alignment = align_point_sets(est_xyz, gt_xyz, options.with_scale);
+  r.alignment = options.fixed_alignment ? *options.fixed_alignment : align_point_sets(est_xyz, gt_xyz, options.with_scale);
   std::vector<double> errors;
   errors.reserve(matches.size());
   r.pairs.reserve(matches.size());

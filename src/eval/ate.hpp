@@ -3,6 +3,7 @@
 // and ground truth by timestamp, align the associated estimate positions onto the ground truth (rigid by
 // default, Sim(3) on request), then summarise the per-pair translational error.
 #include <cstddef>
+#include <optional>
 #include <vector>
 
 #include "core/trajectory.hpp"
@@ -16,6 +17,9 @@ struct AteOptions {
   double max_difference = 0.02;  // seconds, association window (strict)
   double offset = 0.0;           // seconds added to the estimate's timestamps
   bool with_scale = false;       // Sim(3) alignment for monocular estimates
+  /// Evaluate through this alignment instead of fitting one: a localization run in a saved map is measured in the
+  /// map's own alignment to ground truth, so a run that sits consistently offset shows its offset.
+  std::optional<Alignment> fixed_alignment;
 };
 
 struct AtePair {

@@ -13,6 +13,7 @@
 #include "io/depth_image.hpp"
 #include "io/settings_registry.hpp"
 #include "semantic/dynamic_keypoint_masker.hpp"
+#include "mapfile/map_file.hpp"
 
 namespace varslam {
 namespace {
@@ -178,6 +179,13 @@ void Slam::start(std::span<const RgbdFrame> samples) {
   const DepthRegistrationEvent reg = register_depth_if_needed(samples, settings_, cfg_);
   system_ = std::make_unique<slam::System>(cfg_, settings_.camera, settings_.close_depth_m(), options_.mode,
                                            relay_.get());
+  if (pending_map_) {
+    mapfile::check_map_compatible(pending_map_->fingerprint, settings_.camera, cfg_.orb.n_levels, cfg_.orb.scale_factor,
+                               pending_map_file_.string());
+    system_->adopt_map(*pending_map_);
+    pending_map_.reset();
+  }
+  system_->set_localization_only(localization_only_);
   if (masker_) install_person_filter();
   emit(reg, &Observer::on_depth_registration);
 }
@@ -288,6 +296,39 @@ void Slam::finish() {
     throw;
   }
   deliver_queued();
+}
+
+void Slam::load_map(const std::filesystem::path& file) {
+  if (system_) throw std::logic_error("Slam::load_map after the first frame");
+  slam::SavedMap m = mapfile::load_map_file(file);
+  mapfile::check_map_compatible(m.fingerprint, settings_.camera, cfg_.orb.n_levels, cfg_.orb.scale_factor, file.string());
+  loaded_alignment_ = m.groundtruth_alignment;
+  pending_map_file_ = file;
+  pending_map_ = std::move(m);
+}
+
+void Slam::set_localization_only(bool on) {
+  if (on && !system_ && !pending_map_)
+    throw std::logic_error("Slam::set_localization_only: there is no map to localize in (load_map() first)");
+  localization_only_ = on;
+  if (system_) system_->set_localization_only(on);
+}
+
+void Slam::save_map(const std::filesystem::path& file, const std::optional<Eigen::Isometry3d>& groundtruth_alignment) const {
+  if (!finished_) throw std::logic_error("Slam::save_map before finish()");
+  if (!system_) throw InputError(fmt::format("{}: no map to save (no frame was tracked)", file.string()));
+  mapfile::MapFingerprint fp;
+  fp.camera = settings_.camera;
+  fp.n_levels = cfg_.orb.n_levels;
+  fp.scale_factor = cfg_.orb.scale_factor;
+  fp.close_depth = settings_.close_depth_m();
+  fp.disparity_weight = cfg_.tracking.disparity_weight;
+  fp.settings_yaml = settings_yaml(settings_);
+  fp.created_by = "varslam " + std::string(kVersion);
+  slam::SavedMap m = system_->snapshot(std::move(fp));
+  if (m.keyframes.empty()) throw InputError(fmt::format("{}: no map to save (no keyframe)", file.string()));
+  m.groundtruth_alignment = groundtruth_alignment;
+  mapfile::save_map_file(m, file);
 }
 
 Trajectory Slam::camera_trajectory() const { return system_ ? system_->camera_trajectory() : Trajectory{}; }

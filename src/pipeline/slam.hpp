@@ -9,7 +9,9 @@
 //   for (...) { const varslam::FrameResult r = slam.track(bgr, depth16, t); if (r.T_wc) use(*r.T_wc); }
 //   slam.finish();
 //   const varslam::Trajectory traj = slam.camera_trajectory();
+#include <filesystem>
 #include <memory>
+#include <optional>
 #include <mutex>
 #include <span>
 #include <vector>
@@ -26,6 +28,9 @@
 namespace varslam {
 
 using slam::RunMode;
+
+/// The library's version (the CMake project version).
+inline constexpr std::string_view kVersion = VARSLAM_VERSION_STRING;
 
 namespace semantic {
 class DynamicKeypointMasker;
@@ -68,6 +73,19 @@ class Slam {
   /// What a loader thread may apply to each frame before track() (thread-safe; valid after calibrate_depth()):
   /// warps unregistered depth into the colour camera. track() does it itself for frames that did not get it.
   std::function<void(RgbdFrame&)> frame_preparation() const;
+
+  /// Before the first frame: start from a map saved by save_map() (the first frames relocalize in it). Throws
+  /// InputError naming the file when it is not a usable map or was built with another camera or ORB pyramid.
+  void load_map(const std::filesystem::path& file);
+  /// Track against the map without extending it (no keyframes, no points, no new segment): the live pose in a
+  /// known map, as a robot uses it. Needs a loaded map when switched on before the first frame.
+  void set_localization_only(bool on);
+  /// After finish(): writes the map (atomically). `groundtruth_alignment` (map frame -> ground-truth frame), when
+  /// the caller has one, goes with it so runs in this map can be evaluated in its frame.
+  void save_map(const std::filesystem::path& file,
+                const std::optional<Eigen::Isometry3d>& groundtruth_alignment = std::nullopt) const;
+  /// The loaded map's alignment to ground truth, when it has one.
+  const std::optional<Eigen::Isometry3d>& loaded_map_alignment() const { return loaded_alignment_; }
 
   /// Tracks one frame. `bgr`: CV_8UC3 (or CV_8UC1 gray); `depth`: CV_16UC1 raw (divided by depth.factor) or
   /// CV_32FC1 metres, 0 = no depth; both of the camera's size. `boxes`: the people in this image from the caller's
@@ -113,6 +131,10 @@ class Slam {
   std::unique_ptr<slam::System> system_;     // built by start(), once the colour camera is known
   const slam::Map empty_map_;               // what map() shows before the first frame
   Trajectory live_;
+  std::optional<mapfile::SavedMap> pending_map_;  // loaded, adopted when the system starts
+  std::filesystem::path pending_map_file_;
+  std::optional<Eigen::Isometry3d> loaded_alignment_;
+  bool localization_only_ = false;
   std::size_t frames_ = 0, tracked_ = 0;
   bool finished_ = false;
 };

@@ -38,10 +38,27 @@ std::vector<RgbdFrame> registration_samples(const Dataset& ds, std::size_t first
   return samples;
 }
 
-// ATE and RPE against ground truth, into the metrics, with the aligned trajectory next to the others.
-void evaluate_against(const Trajectory& gt, const Trajectory& traj, const Trajectory& live,
-                      const std::vector<double>& stamps, const std::filesystem::path& out_dir, nlohmann::json& m,
-                      RunSummary& sum) {
+Alignment to_alignment(const Eigen::Isometry3d& T) {
+  Alignment a;
+  a.R = T.linear();
+  a.t = T.translation();
+  return a;
+}
+
+Eigen::Isometry3d to_isometry(const Alignment& a) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = a.R;
+  T.translation() = a.t;
+  return T;
+}
+
+// ATE and RPE against ground truth, into the metrics, with the aligned trajectory next to the others. Returns the
+// final trajectory's alignment (estimate -> ground truth), nullopt when there is no ATE.
+std::optional<Eigen::Isometry3d> evaluate_against(const Trajectory& gt, const Trajectory& traj, const Trajectory& live,
+                                                  const std::vector<double>& stamps,
+                                                  const std::optional<Eigen::Isometry3d>& map_alignment,
+                                                  const std::filesystem::path& out_dir, nlohmann::json& m,
+                                                  RunSummary& sum) {
   try {
     const AteResult ate = evaluate_ate(gt, traj);
     sum.ate_rmse = ate.stats.rmse;
@@ -62,9 +79,26 @@ void evaluate_against(const Trajectory& gt, const Trajectory& traj, const Trajec
       const AteResult live_ate = evaluate_ate(gt, live);
       m["ate_live"] = {{"rmse", live_ate.stats.rmse}, {"max", live_ate.stats.max}, {"pairs", live_ate.stats.count}};
     }
+    if (map_alignment) {
+      // In the loaded map's own alignment to ground truth: what a robot localizing in that map gets.
+      AteOptions in_map;
+      in_map.fixed_alignment = to_alignment(*map_alignment);
+      const AteResult fin = evaluate_ate(gt, traj, in_map);
+      sum.ate_map_frame_rmse = fin.stats.rmse;
+      sum.ate_map_frame_max = fin.stats.max;
+      m["ate_map_frame"] = {{"rmse", fin.stats.rmse}, {"max", fin.stats.max}, {"pairs", fin.stats.count},
+                            {"correct_rate", correct_rate(fin.stats.count, covered)}};
+      if (live.size() >= 2) {
+        const AteResult lv = evaluate_ate(gt, live, in_map);
+        m["ate_live_map_frame"] = {{"rmse", lv.stats.rmse}, {"max", lv.stats.max}, {"pairs", lv.stats.count},
+                                   {"correct_rate", correct_rate(lv.stats.count, covered)}};
+      }
+    }
+    return to_isometry(ate.alignment);
   } catch (const InputError& e) {
     sum.ate_note = fmt::format("not computed: {}", e.what());
   }
+  return std::nullopt;
 }
 
 // What a run that tracked almost nothing most likely lacked.
@@ -156,6 +190,13 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const RunO
   std::optional<FilterStageWriter> stages;
   if (!options.debug_frames.empty()) slam.add_observer(stages.emplace(options.debug_frames, out_dir));
   for (Observer* o : options.observers) slam.add_observer(*o);
+  double map_load_ms = 0;
+  if (options.load_map) {
+    const auto t0 = Clock::now();
+    slam.load_map(*options.load_map);
+    map_load_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  }
+  if (options.localization_only) slam.set_localization_only(true);
   slam.calibrate_depth(slam.wants_depth_samples() ? registration_samples(dataset, first, count)
                                                  : std::vector<RgbdFrame>{});
 
@@ -210,8 +251,13 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const RunO
   nlohmann::json skipped = nlohmann::json::array();
   for (const SkippedFrame& f : prefetch.skipped_frames()) skipped.push_back({{"index", f.index}, {"reason", f.reason}});
   m["skipped_frames"] = skipped;
+  if (options.load_map)
+    m["loaded_map"] = {{"path", options.load_map->string()}, {"load_ms", map_load_ms},
+                       {"localization_only", options.localization_only}};
+  std::optional<Eigen::Isometry3d> alignment;
   if (groundtruth && traj.size() >= 2) {
-    evaluate_against(*groundtruth, traj, slam.live_trajectory(), metrics.frame_timestamps(), out_dir, m, sum);
+    alignment = evaluate_against(*groundtruth, traj, slam.live_trajectory(), metrics.frame_timestamps(),
+                                 slam.loaded_map_alignment(), out_dir, m, sum);
   } else if (groundtruth) {
     sum.ate_note = fmt::format("not computed: {} tracked pose{} (2 needed)", traj.size(), traj.size() == 1 ? "" : "s");
   }
@@ -224,6 +270,15 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const RunO
   m["status"] = interrupted ? "interrupted" : sum.failure ? "failed" : "ok";
   if (sum.failure) m["failure"] = *sum.failure;
   sum.metrics = m;
+  if (options.save_map) {
+    // A map built on a loaded one keeps the loaded map's frame, and so its alignment.
+    const auto map_alignment = slam.loaded_map_alignment() ? slam.loaded_map_alignment() : alignment;
+    const auto t0 = Clock::now();
+    slam.save_map(*options.save_map, map_alignment);
+    m["map_file"] = {{"path", options.save_map->string()},
+                     {"bytes", std::filesystem::file_size(*options.save_map)},
+                     {"save_ms", std::chrono::duration<double, std::milli>(Clock::now() - t0).count()}};
+  }
   write_file_atomically(out_dir / "metrics.json", m.dump(2) + "\n", "metrics file");
   return sum;
 }

@@ -27,6 +27,10 @@ struct RunOptions {
   // A run tracking a smaller share of its frames failed (RunSummary::failure says why); 0 accepts any run.
   double min_tracked_share = 0.5;
   const std::atomic<bool>* stop = nullptr;  // set (e.g. by a signal handler) to end the run early, cleanly
+  std::optional<std::filesystem::path> load_map;  // start from this saved map
+  bool localization_only = false;                 // with load_map: track without extending the map
+  // Write the final map here; with ground truth, the final trajectory's alignment goes with it.
+  std::optional<std::filesystem::path> save_map;
 };
 
 struct RunSummary {
@@ -34,6 +38,7 @@ struct RunSummary {
   int segments = 0;
   double wall_seconds = 0, fps = 0;
   std::optional<double> ate_rmse, ate_max;
+  std::optional<double> ate_map_frame_rmse, ate_map_frame_max;  // a run on a loaded map, in the map's alignment
   std::string ate_note;          // why there is no ATE although ground truth exists
   std::optional<std::string> failure;  // the run tracked too little: the share and the likely cause
   bool interrupted = false;      // stopped through RunOptions::stop; the outputs hold what was tracked

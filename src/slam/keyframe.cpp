@@ -184,6 +184,24 @@ void KeyFrame::change_parent(const KeyFramePtr& kf) {
   kf->add_child(shared_from_this());
 }
 
+void KeyFrame::restore_graph(const std::vector<std::pair<KeyFramePtr, int>>& connections, const KeyFramePtr& parent) {
+  {
+    std::lock_guard lock(graph_mutex_);
+    connections_.clear();
+    for (const auto& [kf, w] : connections) connections_[kf] = w;
+    sort_connections_locked();
+    first_connection_ = false;
+  }
+  if (parent) change_parent(parent);
+}
+
+std::vector<std::pair<KeyFramePtr, int>> KeyFrame::connections() const {
+  std::lock_guard lock(graph_mutex_);
+  std::vector<std::pair<KeyFramePtr, int>> out;
+  for (std::size_t i = 0; i < ordered_covisibles_.size(); ++i) out.emplace_back(ordered_covisibles_[i], ordered_weights_[i]);
+  return out;
+}
+
 void KeyFrame::set_bad() {
   if (id_ == 0 || not_erase_) return;
   if (bad_.exchange(true)) return;

@@ -21,6 +21,9 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
 
   long id() const { return id_; }
   long frame_id() const { return frame_id_; }
+  /// The map segment it belongs to (1 = the first initialisation; a new one after each reinitialisation).
+  int segment() const { return segment_; }
+  void set_segment(int segment) { segment_ = segment; }
   double timestamp() const { return timestamp_; }
   const FrameFeatures& features() const { return *features_; }
   const std::shared_ptr<const FrameFeatures>& features_ptr() const { return features_; }
@@ -58,6 +61,11 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   void add_child(const std::shared_ptr<KeyFrame>& kf);
   void erase_child(const std::shared_ptr<KeyFrame>& kf);
   void change_parent(const std::shared_ptr<KeyFrame>& kf);
+  /// A loaded map's graph as it was saved: covisibility edges and spanning-tree parent (null for a root).
+  void restore_graph(const std::vector<std::pair<std::shared_ptr<KeyFrame>, int>>& connections,
+                     const std::shared_ptr<KeyFrame>& parent);
+  /// Covisibility edges with their weights, heaviest first.
+  std::vector<std::pair<std::shared_ptr<KeyFrame>, int>> connections() const;
 
   /// Detaches the keyframe from its points and the graph, reconnecting its children; never the first one.
   void set_bad();
@@ -78,6 +86,7 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   const long id_;
   const long frame_id_;
   const double timestamp_;
+  int segment_ = 1;  // set once, before the keyframe is shared
   std::shared_ptr<const FrameFeatures> features_;
 
   mutable std::mutex pose_mutex_;

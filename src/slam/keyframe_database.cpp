@@ -28,6 +28,18 @@ void KeyframeDatabase::add(const KeyFramePtr& kf) {
   entries_.push_back(std::move(e));
 }
 
+void KeyframeDatabase::add(const KeyFramePtr& kf, cv::Mat signature) {
+  std::lock_guard lock(mutex_);
+  entries_.push_back({kf, std::move(signature)});
+}
+
+cv::Mat KeyframeDatabase::signature_of(const KeyFrame& kf) const {
+  std::lock_guard lock(mutex_);
+  for (const Entry& e : entries_)
+    if (e.keyframe.get() == &kf) return e.signature;
+  return {};
+}
+
 std::size_t KeyframeDatabase::size() const {
   std::lock_guard lock(mutex_);
   return entries_.size();

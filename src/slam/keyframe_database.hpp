@@ -29,6 +29,10 @@ class KeyframeDatabase {
   cv::Mat signature(const FrameFeatures& f) const;
 
   void add(const KeyFramePtr& kf);
+  /// Adds with a signature computed before (a loaded map's).
+  void add(const KeyFramePtr& kf, cv::Mat signature);
+  /// The signature stored for a keyframe; empty when it is not in the database.
+  cv::Mat signature_of(const KeyFrame& kf) const;
   std::size_t size() const;
 
   /// Keyframes (not bad, not excluded) whose signature matches `query_signature` in at least `min_score`

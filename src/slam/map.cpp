@@ -1,5 +1,7 @@
 #include "slam/map.hpp"
 
+#include <algorithm>
+
 namespace varslam::slam {
 
 void Map::add_keyframe(const KeyFramePtr& kf) {
@@ -53,6 +55,11 @@ void Map::clear() {
   // Setting every point bad drops the keyframe->point and point->keyframe references.
   for (const auto& mp : mps) mp->set_bad();
   for (const auto& kf : kfs) kf->clear_graph();
+}
+
+void Map::continue_ids(long next_keyframe_id, long next_map_point_id) {
+  next_kf_id_.store(std::max(next_kf_id_.load(), next_keyframe_id));
+  next_mp_id_.store(std::max(next_mp_id_.load(), next_map_point_id));
 }
 
 }  // namespace varslam::slam

@@ -27,6 +27,8 @@ class Map {
   std::size_t num_map_points() const;
 
   long next_keyframe_id() { return next_kf_id_++; }
+  /// After loading a saved map: new keyframes and points get ids after the loaded ones.
+  void continue_ids(long next_keyframe_id, long next_map_point_id);
   long next_map_point_id() { return next_mp_id_++; }
 
   /// Breaks the shared_ptr cycles between keyframes and points (call once when done with the map).

@@ -12,6 +12,22 @@ MapPoint::MapPoint(long id, const Eigen::Vector3d& position, const std::shared_p
     : id_(id), first_kf_id_(reference ? reference->id() : -1), first_frame_id_(reference ? reference->frame_id() : -1),
       position_(position), reference_(reference) {}
 
+MapPoint::MapPoint(long id, const Eigen::Vector3d& position, const std::shared_ptr<KeyFrame>& reference,
+                   long first_kf_id, long first_frame_id)
+    : id_(id), first_kf_id_(first_kf_id), first_frame_id_(first_frame_id), position_(position), reference_(reference) {}
+
+void MapPoint::restore_statistics(const Eigen::Vector3d& normal, double min_distance, double max_distance, int visible,
+                                  int found) {
+  {
+    std::lock_guard lock(mutex_);
+    normal_ = normal;
+    min_distance_ = min_distance;
+    max_distance_ = max_distance;
+  }
+  visible_.store(visible);
+  found_.store(found);
+}
+
 Eigen::Vector3d MapPoint::position() const {
   std::lock_guard lock(mutex_);
   return position_;
@@ -158,6 +174,11 @@ void MapPoint::update_normal_and_depth(const std::vector<double>& scale_factors)
   max_distance_ = dist * level_scale;
   min_distance_ = max_distance_ / scale_factors.back();
   normal_ = normal / n;
+}
+
+std::pair<double, double> MapPoint::computed_distance_range() const {
+  std::lock_guard lock(mutex_);
+  return {min_distance_, max_distance_};
 }
 
 double MapPoint::min_distance() const {

@@ -20,6 +20,9 @@ using Observations = std::map<std::shared_ptr<KeyFrame>, int, IdLess>;
 class MapPoint {
  public:
   MapPoint(long id, const Eigen::Vector3d& position, const std::shared_ptr<KeyFrame>& reference);
+  /// A loaded map's point, with the creation facts it was saved with.
+  MapPoint(long id, const Eigen::Vector3d& position, const std::shared_ptr<KeyFrame>& reference, long first_kf_id,
+           long first_frame_id);
 
   long id() const { return id_; }
   long first_keyframe_id() const { return first_kf_id_; }
@@ -52,6 +55,14 @@ class MapPoint {
   void compute_descriptor();
   /// Recomputes mean viewing direction and scale-invariance distances from the observations.
   void update_normal_and_depth(const std::vector<double>& scale_factors);
+
+  /// A loaded map's viewing direction, distance range and tracking counts as they were saved.
+  void restore_statistics(const Eigen::Vector3d& normal, double min_distance, double max_distance, int visible,
+                          int found);
+  /// The tracking counts (visible, found) behind found_ratio().
+  int visible() const { return visible_.load(); }
+  /// The distance range as computed (min_distance()/max_distance() widen it for matching).
+  std::pair<double, double> computed_distance_range() const;
 
   double min_distance() const;
   double max_distance() const;

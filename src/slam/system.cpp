@@ -21,6 +21,18 @@ System::~System() {
   map_.clear();
 }
 
+void System::adopt_map(const SavedMap& saved) {
+  if (map_.num_keyframes() > 0) throw std::logic_error("System::adopt_map: the map is not empty");
+  restore_map(saved, map_, places_, tracker_.scale());
+  int segments = 0;
+  for (const auto& k : saved.keyframes) segments = std::max(segments, k.segment);
+  tracker_.start_in_loaded_map(saved.next_frame_id, segments);
+}
+
+SavedMap System::snapshot(MapFingerprint fingerprint) const {
+  return snapshot_map(map_, places_, std::move(fingerprint), tracker_.next_frame_id());
+}
+
 TrackOutcome System::process(const RgbdFrame& frame) {
   // After a mapping error the map is no longer consistent: every later call reports that error.
   if (const auto failure = mapper_.failure()) std::rethrow_exception(failure);

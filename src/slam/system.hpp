@@ -10,6 +10,7 @@
 #include "slam/keyframe_database.hpp"
 #include "slam/local_mapping.hpp"
 #include "slam/loop_closing.hpp"
+#include "slam/map_snapshot.hpp"
 #include "slam/tracking.hpp"
 
 namespace varslam::slam {
@@ -30,6 +31,12 @@ class System {
   TrackOutcome process(const RgbdFrame& frame);
   /// Finishes local mapping (real-time mode) so the map is final; rethrows a mapping thread's exception.
   void finish();
+
+  /// Before the first frame: continue from a saved map (compatibility is the caller's check).
+  void adopt_map(const SavedMap& saved);
+  /// The map as records, after finish() (real-time mode: mapping must be idle).
+  SavedMap snapshot(MapFingerprint fingerprint) const;
+  void set_localization_only(bool on) { tracker_.set_localization_only(on); }
 
   void set_keypoint_filter(KeypointFilterFn fn) { tracker_.set_keypoint_filter(std::move(fn)); }
   void set_extraction_mask(ExtractionMaskFn fn) { tracker_.set_extraction_mask(std::move(fn)); }

@@ -111,8 +111,9 @@ TrackOutcome Tracker::track(const RgbdFrame& input) {
   if (ok) {
     state_ = TrackState::Ok;
     lost_count_ = 0;
-    velocity_ = cur.T_cw * last_.T_cw.inverse();
-    has_velocity_ = true;
+    // The first pose in a loaded map has no predecessor to take a velocity from.
+    has_velocity_ = !std::exchange(awaiting_loaded_map_, false);
+    velocity_ = has_velocity_ ? cur.T_cw * last_.T_cw.inverse() : Eigen::Isometry3d::Identity();
     clean_temporary_matches(cur);
     for (std::size_t i = 0; i < cur.map_points.size(); ++i)
       if (cur.map_points[i] && cur.outlier[i]) cur.map_points[i].reset();
@@ -130,7 +131,10 @@ TrackOutcome Tracker::track(const RgbdFrame& input) {
     state_ = TrackState::Lost;
     cur.T_cw = (has_velocity_ ? velocity_ : Eigen::Isometry3d::Identity()) * last_.T_cw;
     std::fill(cur.map_points.begin(), cur.map_points.end(), nullptr);
-    if (lost_count_ > cfg_.tracking.lost_frames_before_reinit && initialize(cur, cur.T_cw)) {
+    const int patience =
+        awaiting_loaded_map_ ? cfg_.relocalization.loaded_map_patience : cfg_.tracking.lost_frames_before_reinit;
+    if (!localization_only_ && lost_count_ > patience && initialize(cur, cur.T_cw)) {
+      awaiting_loaded_map_ = false;
       spdlog::warn("tracking lost for {} frames at t={:.3f}: new map segment started", lost_count_, cur.timestamp);
       state_ = TrackState::Ok;
       lost_count_ = 0;
@@ -154,6 +158,13 @@ TrackOutcome Tracker::track(const RgbdFrame& input) {
   return out;
 }
 
+void Tracker::start_in_loaded_map(long next_frame_id, int segments) {
+  next_frame_id_ = std::max(next_frame_id_, next_frame_id);
+  segments_ = segments;
+  state_ = TrackState::Lost;
+  awaiting_loaded_map_ = true;
+}
+
 bool Tracker::initialize(Frame& cur, const Eigen::Isometry3d& T_cw) {
   if (static_cast<int>(cur.features->size()) < kMinKeypointsToInitialize) return false;
   int with_depth = 0;
@@ -162,8 +173,8 @@ bool Tracker::initialize(Frame& cur, const Eigen::Isometry3d& T_cw) {
   cur.T_cw = T_cw;
   cur.has_pose = true;
   std::fill(cur.map_points.begin(), cur.map_points.end(), nullptr);
-  insert_keyframe_with_depth_points(cur, true);
   ++segments_;
+  insert_keyframe_with_depth_points(cur, true);
   last_is_keyframe_ = true;
   spdlog::debug("map segment {} initialised with {} points", segments_, cur.num_tracked());
   return true;
@@ -314,7 +325,7 @@ int Tracker::track_reference_keyframe(Frame& cur, const KeyFramePtr& kf, FrameTi
 
 bool Tracker::recover(Frame& cur, FrameTimings& t) {
   // Try the keyframes around the last reference, best first, from the motion-model prediction.
-  if (!reference_kf_) return false;
+  if (!reference_kf_) return relocalize(cur, t);  // a loaded map: no reference yet
   std::vector<KeyFramePtr> candidates{reference_kf_};
   for (const auto& kf : reference_kf_->best_covisibles(5)) candidates.push_back(kf);
   const Eigen::Isometry3d predicted = (has_velocity_ ? velocity_ : Eigen::Isometry3d::Identity()) * last_.T_cw;
@@ -438,6 +449,7 @@ void Tracker::clean_temporary_matches(Frame& cur) {
 }
 
 bool Tracker::need_keyframe(const Frame& cur, int inliers) const {
+  if (localization_only_) return false;
   if (!reference_kf_) return true;
   const std::size_t n_kfs = map_.num_keyframes();
   // The reference keyframe's points that count: seen by 3 keyframes (2 while the map is that small).
@@ -478,6 +490,7 @@ void Tracker::create_keyframe(Frame& cur) { insert_keyframe_with_depth_points(cu
 
 KeyFramePtr Tracker::insert_keyframe_with_depth_points(Frame& cur, bool all_depth_points) {
   auto kf = std::make_shared<KeyFrame>(map_.next_keyframe_id(), cur);
+  kf->set_segment(segments_);
   const FrameFeatures& F = *cur.features;
   std::vector<std::pair<float, int>> by_depth;
   for (std::size_t i = 0; i < F.size(); ++i)

@@ -78,6 +78,15 @@ class Tracker {
   /// Keyframes to relocalize against when tracking is lost (none: only the last reference's neighbourhood).
   void set_place_database(const KeyframeDatabase* places) { places_ = places; }
 
+  /// Before the first frame, on a loaded map: the first frames relocalize in it (no new segment until
+  /// relocalization.loaded_map_patience frames failed); frame ids continue after the map's.
+  void start_in_loaded_map(long next_frame_id, int segments);
+  /// Localization only: track against the map without adding keyframes or points, and never start a new segment
+  /// (a lost frame stays lost until relocalization finds it). May be switched at any frame.
+  void set_localization_only(bool on) { localization_only_ = on; }
+  bool localization_only() const { return localization_only_; }
+  long next_frame_id() const { return next_frame_id_; }
+
   TrackState state() const { return state_; }
   const std::vector<FrameRecord>& records() const { return records_; }
   const Frame& last_frame() const { return last_; }
@@ -129,6 +138,8 @@ class Tracker {
   long last_recovery_frame_id_ = -1000;
   int lost_count_ = 0;
   int segments_ = 0;
+  bool awaiting_loaded_map_ = false;  // started on a loaded map and not relocalized in it yet
+  bool localization_only_ = false;
   int relocalizations_ = 0;
   std::optional<Relocalization> relocalized_;  // of the frame being tracked, moved into its TrackOutcome
   long seen_corrections_ = 0;  // map_.corrections() when the last frame was last re-anchored

@@ -256,6 +256,20 @@ TEST(BadInput, SigintStopsTheRunCleanlyAndKeepsWhatWasTracked) {
 }
 
 // README's command 1 runs `varslam demo` from the checkout with a relative --out: its person boxes must be found.
+TEST(BadInput, MapOptionsAreCheckedBeforeTheRun) {
+  const Outcome alone = cli(run_on(base_sequence(), "loc_only", "--localization-only"));
+  EXPECT_EQ(alone.exit_code, 2) << alone.output;
+  EXPECT_THAT(alone.output, HasSubstr("--localization-only needs a map to localize in"));
+  const fs::path not_a_map = out_path("not_a_map.map");
+  std::ofstream(not_a_map) << "camera:\n  fx: 500\n";
+  const Outcome bad = cli(run_on(base_sequence(), "bad_map", "--load-map " + not_a_map.string()));
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_THAT(bad.output, HasSubstr(not_a_map.string() + ": not a varslam map"));
+  const Outcome missing = cli(run_on(base_sequence(), "missing_map", "--load-map /nonexistent/x.map"));
+  EXPECT_EQ(missing.exit_code, 2) << missing.output;
+  EXPECT_THAT(missing.output, HasSubstr("/nonexistent/x.map: map file not found"));
+}
+
 TEST(Demo, RunsFromARelativeFolderWithThePersonFilter) {
   const fs::path dir = out_dir("demo_cwd");
   fs::create_directories(dir);

@@ -197,9 +197,29 @@ TEST(Ate, ScaledCopyGivesKnownErrorsRigidlyAndNoneWithScale) {
   EXPECT_NEAR(rigid.stats.std, std::sqrt(2.0 * (0.01 + 0.0 + 0.01) / 6), 1e-12);
   EXPECT_NEAR(rigid.pairs[4].error, 0.3, 1e-12);
 
-  const AteResult sim = evaluate_ate(gt, est, {0.02, 0.0, true});
+  AteOptions with_scale;
+  with_scale.with_scale = true;
+  const AteResult sim = evaluate_ate(gt, est, with_scale);
   EXPECT_NEAR(sim.alignment.scale, 1.0 / 1.1, 1e-12);
   EXPECT_LT(sim.stats.max, 1e-12);
+}
+
+TEST(Ate, AFixedAlignmentShowsAConsistentOffsetThatAFreshOneHides) {
+  Trajectory gt, est;
+  for (int i = 0; i < 10; ++i) {
+    StampedPose p;
+    p.timestamp = i * 0.1;
+    p.T_wc.translation() = Eigen::Vector3d(0.1 * i, 0.02 * i * i, 0);
+    gt.push_back(p);
+    p.T_wc.translation() += Eigen::Vector3d(0.05, 0, 0);  // sits 5 cm off, every frame
+    est.push_back(p);
+  }
+  EXPECT_LT(evaluate_ate(gt, est).stats.max, 1e-9);
+  AteOptions in_map;
+  in_map.fixed_alignment = Alignment{};  // the map frame is the ground-truth frame
+  const AteResult r = evaluate_ate(gt, est, in_map);
+  EXPECT_NEAR(r.stats.rmse, 0.05, 1e-9);
+  EXPECT_NEAR(r.stats.min, 0.05, 1e-9);
 }
 
 TEST(Ate, TooFewMatchesIsAnInputError) {

@@ -1,0 +1,235 @@
+// Saved maps: the file round-trips exactly, a broken or foreign file is refused
+// with a message naming it and the problem, and a run on a loaded map
+// relocalizes in it (localization only: without extending it).
+#include "mapfile/map_file.hpp"
+
+#include <fmt/format.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "io/dataset.hpp"
+#include "io/settings_registry.hpp"
+#include "slam/e2e_support.hpp"
+#include "slam/system.hpp"
+
+namespace varslam::slam {
+namespace {
+
+using namespace mapfile;
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+
+fs::path static_sequence() {
+  synth::SynthConfig cfg;
+  cfg.scenario = "static";
+  cfg.seconds = 4.0;
+  cfg.seed = 4;
+  return e2e::cached_sequence("map_static_4s", cfg);
+}
+
+fs::path temp_path(const std::string &name) {
+  return fs::temp_directory_path() /
+         ("varslam_map_" + name + "_" + std::to_string(::getpid()));
+}
+
+std::string bytes_of(const fs::path &p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+run::RunSummary run_frames(std::size_t first, std::size_t count,
+                           const std::string &name,
+                           const std::optional<fs::path> &load = std::nullopt,
+                           bool localization_only = false,
+                           const std::optional<fs::path> &save = std::nullopt,
+                           const std::vector<std::string> &overrides = {},
+                           fs::path data = static_sequence()) {
+  Settings settings = settings_for_dataset(data, std::nullopt);
+  apply_setting_overrides(settings, overrides);
+  auto ds = open_dataset(data, settings);
+  run::RunOptions ro;
+  ro.progress = false;
+  ro.first = first;
+  ro.max_frames = count;
+  ro.load_map = load;
+  ro.localization_only = localization_only;
+  ro.save_map = save;
+  ro.min_tracked_share = 0;
+  const fs::path out = temp_path(name);
+  fs::remove_all(out);
+  return run::run_slam(*ds, settings, ro, out);
+}
+
+// One map of the first 90 frames (3 keyframes), shared by the tests of this
+// file.
+const fs::path &saved_map() {
+  static const fs::path file = [] {
+    const fs::path f = temp_path("first90.map");
+    run_frames(0, 90, "first90", std::nullopt, false, f);
+    return f;
+  }();
+  return file;
+}
+
+std::string decode_error(const std::string &bytes) {
+  try {
+    decode_map(bytes, "test.map");
+  } catch (const InputError &e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "decoded without an error";
+  return "";
+}
+
+TEST(MapFile, SavedMapHasTheRunsKeyframesPointsAndGraph) {
+  const SavedMap m = load_map_file(saved_map());
+  ASSERT_GE(m.keyframes.size(), 3u);
+  EXPECT_GE(m.map_points.size(), 400u);
+  EXPECT_TRUE(m.groundtruth_alignment.has_value()); // the run had ground truth
+  EXPECT_EQ(m.fingerprint.camera.width, 640);
+  EXPECT_THAT(m.fingerprint.settings_yaml, HasSubstr("camera:"));
+  int roots = 0, with_connections = 0;
+  for (const auto &k : m.keyframes) {
+    roots += k.parent == -1;
+    with_connections += !k.connections.empty();
+    EXPECT_EQ(k.descriptors.rows, static_cast<int>(k.keypoints.size()));
+    EXPECT_GT(k.signature.rows, 0);
+    EXPECT_EQ(k.segment, 1);
+  }
+  EXPECT_EQ(roots, 1); // one segment: one spanning tree
+  EXPECT_EQ(with_connections, static_cast<int>(m.keyframes.size()));
+}
+
+TEST(MapFile, SaveLoadSaveGivesTheSameBytes) {
+  const std::string first = bytes_of(saved_map());
+  const SavedMap saved = decode_map(first, saved_map().string());
+  EXPECT_EQ(encode_map(saved), first); // the codec alone
+
+  // Through the live map: restored into a system and snapshotted again.
+  const Settings settings =
+      settings_for_dataset(static_sequence(), std::nullopt);
+  const SlamConfig cfg = slam_config_from(settings);
+  System system(cfg, settings.camera, settings.close_depth_m(),
+                RunMode::Deterministic);
+  system.adopt_map(saved);
+  SavedMap again = system.snapshot(saved.fingerprint);
+  again.groundtruth_alignment = saved.groundtruth_alignment;
+  EXPECT_EQ(encode_map(again), first);
+}
+
+TEST(MapFile, BrokenOrForeignFilesAreRefusedByName) {
+  const std::string good = bytes_of(saved_map());
+  EXPECT_THAT(decode_error(""), HasSubstr("not a varslam map"));
+  EXPECT_THAT(decode_error("camera:\n  fx: 500\n"),
+              HasSubstr("not a varslam map"));
+  EXPECT_THAT(decode_error(good.substr(0, good.size() / 2)),
+              HasSubstr("truncated or corrupted"));
+  std::string flipped = good;
+  flipped[flipped.size() - 100] ^= 0x5a;
+  EXPECT_THAT(decode_error(flipped), HasSubstr("checksum"));
+
+  using json = nlohmann::json;
+  json outer = json::from_cbor(good.begin() + 8, good.end());
+  outer["version"] = kMapFormatVersion + 1;
+  const auto v2 = json::to_cbor(outer);
+  EXPECT_THAT(
+      decode_error(good.substr(0, 8) + std::string(v2.begin(), v2.end())),
+      HasSubstr(fmt::format("map format version {}", kMapFormatVersion + 1)));
+
+  // Well-formed bytes whose records do not hold together.
+  SavedMap m = decode_map(good, "good");
+  m.map_points.front().reference_keyframe = 999999;
+  EXPECT_THAT(decode_error(encode_map(m)),
+              HasSubstr("reference keyframe not in the map"));
+  m = decode_map(good, "good");
+  m.keyframes.front().points.front().first = 1 << 20;
+  EXPECT_THAT(decode_error(encode_map(m)), HasSubstr(".points"));
+  m = decode_map(good, "good");
+  m.keyframes.front().T_cw.linear() *= 2.0;
+  EXPECT_THAT(decode_error(encode_map(m)), HasSubstr("not a rotation"));
+
+  EXPECT_THROW(load_map_file(temp_path("no_such.map")), InputError);
+}
+
+TEST(MapFile, AnotherCameraOrPyramidIsRefused) {
+  const SavedMap m = load_map_file(saved_map());
+  PinholeCamera cam = m.fingerprint.camera;
+  EXPECT_NO_THROW(check_map_compatible(m.fingerprint, cam,
+                                       m.fingerprint.n_levels,
+                                       m.fingerprint.scale_factor, "x"));
+  cam.fx *= 1.005; // within 1 %: the same sensor recalibrated
+  EXPECT_NO_THROW(check_map_compatible(m.fingerprint, cam,
+                                       m.fingerprint.n_levels,
+                                       m.fingerprint.scale_factor, "x"));
+  cam.fx *= 1.05;
+  try {
+    check_map_compatible(m.fingerprint, cam, m.fingerprint.n_levels,
+                         m.fingerprint.scale_factor, "k.map");
+    ADD_FAILURE();
+  } catch (const InputError &e) {
+    EXPECT_THAT(e.what(),
+                HasSubstr("k.map: the map was built with another camera"));
+  }
+  cam = m.fingerprint.camera;
+  cam.width = 320;
+  EXPECT_THROW(check_map_compatible(m.fingerprint, cam, m.fingerprint.n_levels,
+                                    m.fingerprint.scale_factor, "x"),
+               InputError);
+  EXPECT_THROW(check_map_compatible(m.fingerprint, m.fingerprint.camera, 4,
+                                    m.fingerprint.scale_factor, "x"),
+               InputError);
+}
+
+TEST(MapFile, LocalizationOnlyTracksInTheLoadedMapWithoutExtendingIt) {
+  const SavedMap m = load_map_file(saved_map());
+  const run::RunSummary s = run_frames(90, 30, "localize", saved_map(), true);
+  EXPECT_EQ(s.frames, 30u);
+  EXPECT_GE(s.tracked, 29u);
+  EXPECT_EQ(s.keyframes, m.keyframes.size()); // nothing added
+  EXPECT_EQ(s.metrics["relocalizations"].get<int>(), 1);
+  ASSERT_TRUE(s.ate_map_frame_rmse.has_value());
+  EXPECT_LT(*s.ate_map_frame_rmse,
+            0.03); // in the map's own alignment, not a fresh one
+}
+
+TEST(MapFile, MappingOnALoadedMapExtendsItAfterTheLoadedIds) {
+  const SavedMap m = load_map_file(saved_map());
+  const fs::path extended = temp_path("extended.map");
+  const run::RunSummary s =
+      run_frames(90, 30, "extend", saved_map(), false, extended);
+  EXPECT_GE(s.tracked, 29u);
+  EXPECT_EQ(s.segments, 1); // relocalized in the loaded segment, no new one
+  const SavedMap e = load_map_file(extended);
+  EXPECT_GT(e.keyframes.size(), m.keyframes.size());
+  EXPECT_GE(e.keyframes.back().id, m.next_keyframe_id);
+  EXPECT_GE(e.keyframes.back().frame_id, m.next_frame_id);
+  ASSERT_TRUE(e.groundtruth_alignment.has_value());
+  EXPECT_TRUE(e.groundtruth_alignment->isApprox(
+      *m.groundtruth_alignment)); // still the first run's frame
+}
+
+TEST(MapFile, AMapOfAnotherPlaceGivesANewSegmentAfterThePatience) {
+  synth::SynthConfig cfg;
+  cfg.scenario = "static";
+  cfg.seconds = 1.0;
+  cfg.seed = 9;
+  cfg.path_start = 12; // another stretch of the path: other views
+  const fs::path elsewhere = e2e::cached_sequence("map_elsewhere", cfg);
+  const run::RunSummary s =
+      run_frames(0, 30, "elsewhere", saved_map(), false, std::nullopt,
+                 {"relocalization.loaded_map_patience=5"}, elsewhere);
+  EXPECT_EQ(s.segments,
+            2); // the loaded one, and the one started after 5 failed frames
+  EXPECT_GE(s.tracked, 20u);
+}
+
+} // namespace
+} // namespace varslam::slam
