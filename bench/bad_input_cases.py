@@ -63,7 +63,7 @@ def cases(base, work):
     add("gt_folder", "a folder as --groundtruth", lambda b, o: [b, "run", "-q", "-d", base, "-o", o, "--groundtruth", work])
     for name, desc, line in (("gt_7_columns", "ground truth line with 7 columns", "1311870436.8 0 0 0 0 0 1\n"),
                              ("gt_nan", "ground truth NaN", "1311870436.81 nan 0 0 0 0 0 1\n"),
-                             ("gt_zero_quat", "ground truth zero quaternion", "1311870436.82 0 0 0 0 0 0 0\n")):
+                             ("gt_zero_quat", "ground truth zero quaternion", "1311870499.82 0 0 0 0 0 0 0\n")):
         g = work / f"{name}.txt"
         g.write_text((base / "groundtruth.txt").read_text() + line)
         add(name, desc, lambda b, o, g=g: [b, "run", "-q", "-d", base, "-o", o, "--groundtruth", g])
@@ -94,7 +94,7 @@ def stale_after_gtless(binary, base, work, o):
     ng = copy_base(base, work, "no_gt"); (ng / "groundtruth.txt").unlink()
     subprocess.run([binary, "run", "-q", "-d", base, "-o", o], capture_output=True)
     r = subprocess.run([binary, "run", "-q", "-d", ng, "-o", o, "-n", "1"], capture_output=True, text=True)
-    left = [f for f in ("aligned_trajectory.txt", "report.html") if (Path(o) / f).exists()]
+    left = [f for f in ("CameraTrajectory_aligned.txt",) if (Path(o) / f).exists()]
     return r.returncode, ("stale from the first run: " + ", ".join(left)) if left else "earlier outputs removed"
 
 

@@ -24,7 +24,8 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // --help is a ParseError with code 0; every other one is bad input, like a bad setting (exit 2).
+    return app.exit(e) == 0 ? 0 : varslam::cli::kExitInputError;
   } catch (const varslam::cli::CommandFailed& e) {
     spdlog::error("{}", e.what());
     return e.code;

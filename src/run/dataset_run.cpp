@@ -141,7 +141,8 @@ class OutputFolder {
       const bool ours = name == "CameraTrajectory.txt" || name == "CameraTrajectory_aligned.txt" ||
                         name == "KeyFrameTrajectory.txt" || name == "LiveTrajectory.txt" || name == "map.ply" ||
                         name == "metrics.json" || name == "report.html" || name.rfind("semantic_stages_", 0) == 0;
-      if (ours && std::filesystem::remove(e.path(), ec)) ++removed;
+      // Files only: a folder of that name is the user's, and writing the output there fails with its name.
+      if (ours && e.is_regular_file(ec) && std::filesystem::remove(e.path(), ec)) ++removed;
     }
     if (removed > 0) spdlog::info("{}: removed {} files of an earlier run", dir.string(), removed);
   }
