@@ -297,11 +297,18 @@ BaResult solve_local_ba(const PinholeCamera& cam, BaProblem& problem, const BaCo
 
 KeyframeObservationCounts count_keyframe_observations(const BaProblem& problem,
                                                       const std::vector<bool>& outlier_observation) {
-  KeyframeObservationCounts c{std::vector<int>(problem.keyframes.size()), std::vector<int>(problem.keyframes.size())};
+  const std::size_t n = problem.keyframes.size();
+  KeyframeObservationCounts c{std::vector<int>(n), std::vector<int>(n), std::vector<int>(n), std::vector<int>(n)};
+  std::vector<int> observers(problem.points.size(), 0);
+  for (const BaObservation& o : problem.observations) ++observers[static_cast<std::size_t>(o.point)];
   for (std::size_t o = 0; o < problem.observations.size(); ++o) {
     const auto k = static_cast<std::size_t>(problem.observations[o].keyframe);
+    const bool shared = observers[static_cast<std::size_t>(problem.observations[o].point)] > 1;
     ++c.total[k];
-    if (outlier_observation[o]) ++c.flagged[k];
+    c.shared_total[k] += shared;
+    if (!outlier_observation[o]) continue;
+    ++c.flagged[k];
+    c.shared_flagged[k] += shared;
   }
   return c;
 }
@@ -311,7 +318,8 @@ std::vector<int> keep_diverged_keyframes(BaProblem& problem, const std::vector<E
   const KeyframeObservationCounts counts = count_keyframe_observations(problem, outlier_observation);
   std::vector<int> reset;
   for (std::size_t i = 0; i < problem.keyframes.size(); ++i) {
-    if (problem.keyframes[i].fixed || 2 * counts.flagged[i] <= counts.total[i]) continue;
+    if (problem.keyframes[i].fixed) continue;
+    if (2 * counts.flagged[i] <= counts.total[i] && 2 * counts.shared_flagged[i] <= counts.shared_total[i]) continue;
     problem.keyframes[i].T_cw = before[i];
     reset.push_back(static_cast<int>(i));
   }

@@ -300,8 +300,17 @@ void Slam::finish() {
 
 void Slam::load_map(const std::filesystem::path& file) {
   if (system_) throw std::logic_error("Slam::load_map after the first frame");
-  slam::SavedMap m = mapfile::load_map_file(file);
-  mapfile::check_map_compatible(m.fingerprint, settings_.camera, cfg_.orb.n_levels, cfg_.orb.scale_factor, file.string());
+  mapfile::SavedMap m = mapfile::load_map_file(file);
+  // The colour camera may still change (depth registration is estimated at start()): intrinsics are checked then,
+  // size and pyramid now.
+  PinholeCamera now = settings_.camera;
+  if (wants_depth_samples()) {
+    now.fx = m.fingerprint.camera.fx;
+    now.fy = m.fingerprint.camera.fy;
+    now.cx = m.fingerprint.camera.cx;
+    now.cy = m.fingerprint.camera.cy;
+  }
+  mapfile::check_map_compatible(m.fingerprint, now, cfg_.orb.n_levels, cfg_.orb.scale_factor, file.string());
   loaded_alignment_ = m.groundtruth_alignment;
   pending_map_file_ = file;
   pending_map_ = std::move(m);
@@ -346,6 +355,7 @@ SlamSummary Slam::summary() const {
     s.map_points = system_->map().num_map_points();
     s.segments = system_->tracker().segments();
     s.relocalizations = system_->tracker().relocalizations();
+    system_->camera_trajectory(false, &s.final_poses_repaired);
   }
   s.detector = masker_ ? masker_->detector_name() : "none";
   s.detector_runs = masker_ ? masker_->detector_runs() : 0;

@@ -47,6 +47,7 @@ struct SlamOptions {
 struct SlamSummary {
   std::size_t frames = 0, tracked = 0, keyframes = 0, map_points = 0;
   int segments = 0, relocalizations = 0;
+  int final_poses_repaired = 0;  // final poses no frame supported, replaced (slam/trajectory_guard.hpp)
   std::string detector;        // "none" without the person filter
   long detector_runs = 0;
   bool detector_asynchronous = false;

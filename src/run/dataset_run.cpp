@@ -246,6 +246,10 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const RunO
   write_map_ply(slam.map(), out_dir / "map.ply");
 
   nlohmann::json m = metrics.metrics(slam);
+  if (const int n = m["final_poses_repaired"].get<int>(); n > 0)
+    spdlog::warn("{} final pose{} no frame supported (a lone keyframe left misplaced) replaced by the neighbours' "
+                 "correction of the live pose",
+                 n, n == 1 ? "" : "s");
   m["dataset"] = dataset.root().string();
   m["wall_seconds"] = wall;
   m["fps"] = sum.fps;

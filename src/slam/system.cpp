@@ -1,5 +1,7 @@
 #include "slam/system.hpp"
 
+#include "slam/trajectory_guard.hpp"
+
 namespace varslam::slam {
 
 System::System(const SlamConfig& cfg, const PinholeCamera& camera, double close_depth, RunMode mode,
@@ -47,8 +49,9 @@ void System::finish() {
   if (cfg_.loop.final_global_ba) loop_.run_global_ba();
 }
 
-Trajectory System::camera_trajectory(bool include_lost) const {
+Trajectory System::camera_trajectory(bool include_lost, int* repaired) const {
   Trajectory traj;
+  std::vector<Eigen::Isometry3d> live;
   for (const FrameRecord& r : tracker_.records()) {
     if (!r.tracked && !include_lost) continue;
     if (!r.reference && !r.tracked) continue;
@@ -57,7 +60,10 @@ Trajectory System::camera_trajectory(bool include_lost) const {
     const Eigen::Isometry3d T_cw = r.reference ? r.T_c_ref * r.reference->resolved_pose() : r.T_c_ref;
     p.T_wc = T_cw.inverse();
     traj.push_back(p);
+    live.push_back(r.live_T_cw.inverse());
   }
+  const int n = repair_isolated_poses(traj, live);
+  if (repaired) *repaired = n;
   return traj;
 }
 

@@ -41,8 +41,9 @@ class System {
   void set_keypoint_filter(KeypointFilterFn fn) { tracker_.set_keypoint_filter(std::move(fn)); }
   void set_extraction_mask(ExtractionMaskFn fn) { tracker_.set_extraction_mask(std::move(fn)); }
 
-  /// Camera-to-world pose of every processed frame that has one (tracked, or re-anchored to a new segment).
-  Trajectory camera_trajectory(bool include_lost = false) const;
+  /// Camera-to-world pose of every processed frame that has one (tracked, or re-anchored to a new segment), each
+  /// checked against its neighbours (slam/trajectory_guard.hpp); `repaired` gets how many poses the check replaced.
+  Trajectory camera_trajectory(bool include_lost = false, int* repaired = nullptr) const;
   Trajectory keyframe_trajectory() const;
   const Map& map() const { return map_; }
   Map& map() { return map_; }

@@ -526,6 +526,7 @@ void Tracker::record(const Frame& cur, bool tracked) {
   r.timestamp = cur.timestamp;
   r.tracked = tracked;
   r.reference = cur.reference_kf;
+  r.live_T_cw = cur.T_cw;
   if (r.reference) r.T_c_ref = cur.T_cw * r.reference->pose_inverse();
   else r.T_c_ref = cur.T_cw;
   records_.push_back(r);

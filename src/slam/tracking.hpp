@@ -65,6 +65,7 @@ struct FrameRecord {
   double timestamp = 0;
   KeyFramePtr reference;
   Eigen::Isometry3d T_c_ref = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d live_T_cw = Eigen::Isometry3d::Identity();  // as tracking gave it: what the final pose is checked by
   bool tracked = false;
 };
 

@@ -256,6 +256,7 @@ namespace {
 // kept as solved. Fixed keyframe 2 is never touched.
 TEST(KeepDivergedKeyframes, ResetsOnlyFreeKeyframesLeftWithMostlyOutliers) {
   BaProblem problem;
+  problem.points.resize(10);  // each seen by all three keyframes
   std::vector<Eigen::Isometry3d> before;
   for (int k = 0; k < 3; ++k) {
     Eigen::Isometry3d solved = Eigen::Isometry3d::Identity();
@@ -277,6 +278,33 @@ TEST(KeepDivergedKeyframes, ResetsOnlyFreeKeyframesLeftWithMostlyOutliers) {
   for (int j = 0; j < 10; ++j) EXPECT_FALSE(outlier[static_cast<std::size_t>(j)]) << j;
   EXPECT_TRUE(outlier[10]);
   EXPECT_TRUE(outlier[20]);
+}
+
+// A weak keyframe: 30 private points (seen by it alone, they move with it and are never flagged) and 10 shared
+// with a fixed keyframe, 8 of them flagged. 8 of 40 is a minority, but the shared points are what hold its pose.
+TEST(KeepDivergedKeyframes, ResetsAKeyframeWhoseSharedPointsAreMostlyFlagged) {
+  BaProblem problem;
+  problem.points.resize(40);
+  Eigen::Isometry3d moved = Eigen::Isometry3d::Identity();
+  moved.translation() << 1.7, 0.0, 0.0;
+  problem.keyframes.push_back({moved, false});
+  problem.keyframes.push_back({Eigen::Isometry3d::Identity(), true});
+  const std::vector<Eigen::Isometry3d> before(2, Eigen::Isometry3d::Identity());
+  std::vector<bool> outlier;
+  for (int j = 0; j < 40; ++j) {
+    problem.observations.push_back({0, j, Observation{}});
+    outlier.push_back(j < 8);
+  }
+  for (int j = 0; j < 10; ++j) {
+    problem.observations.push_back({1, j, Observation{}});
+    outlier.push_back(false);
+  }
+  const KeyframeObservationCounts c = count_keyframe_observations(problem, outlier);
+  EXPECT_EQ(c.total[0], 40);
+  EXPECT_EQ(c.shared_total[0], 10);
+  EXPECT_EQ(c.shared_flagged[0], 8);
+  EXPECT_EQ(keep_diverged_keyframes(problem, before, outlier), std::vector<int>{0});
+  EXPECT_TRUE(problem.keyframes[0].T_cw.isApprox(before[0]));
 }
 
 }  // namespace
