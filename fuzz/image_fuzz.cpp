@@ -32,25 +32,21 @@ struct OneFrameDataset {
     dataset = varslam::open_dataset(dir, s);
   }
   void restore_colour() const {
-    cv::imwrite((dir / "rgb.png").string(),
-                cv::Mat(kHeight, kWidth, CV_8UC3, cv::Scalar(40, 90, 200)));
+    cv::imwrite((dir / "rgb.png").string(), cv::Mat(kHeight, kWidth, CV_8UC3, cv::Scalar(40, 90, 200)));
   }
   void restore_depth() const {
-    cv::imwrite((dir / "depth.png").string(),
-                cv::Mat(kHeight, kWidth, CV_16UC1, cv::Scalar(5000)));
+    cv::imwrite((dir / "depth.png").string(), cv::Mat(kHeight, kWidth, CV_16UC1, cv::Scalar(5000)));
   }
 };
 
-} // namespace
+}  // namespace
 
-extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data,
-                                      std::size_t size) {
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace varslam;
   static const OneFrameDataset ds;
-  static int last_fuzzed = -1; // which file the previous input replaced:
-                               // restore it only when switching
-  if (size == 0)
-    return 0;
+  static int last_fuzzed = -1;  // which file the previous input replaced:
+                                // restore it only when switching
+  if (size == 0) return 0;
   const int colour = data[0] & 1;
   if (last_fuzzed != -1 && last_fuzzed != colour) {
     if (colour)
@@ -59,18 +55,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data,
       ds.restore_colour();
   }
   last_fuzzed = colour;
-  fuzz::write_input(colour ? "dataset/rgb.png" : "dataset/depth.png", data + 1,
-                    size - 1);
+  fuzz::write_input(colour ? "dataset/rgb.png" : "dataset/depth.png", data + 1, size - 1);
   RgbdFrame f;
   try {
     f = ds.dataset->load(0);
-  } catch (const InputError &) {
+  } catch (const InputError&) {
     return 0;
   }
-  VARSLAM_FUZZ_EXPECT(f.bgr.cols == kWidth && f.bgr.rows == kHeight &&
-                      f.bgr.type() == CV_8UC3);
-  VARSLAM_FUZZ_EXPECT(f.gray.size() == f.bgr.size() &&
-                      f.depth.size() == f.bgr.size());
+  VARSLAM_FUZZ_EXPECT(f.bgr.cols == kWidth && f.bgr.rows == kHeight && f.bgr.type() == CV_8UC3);
+  VARSLAM_FUZZ_EXPECT(f.gray.size() == f.bgr.size() && f.depth.size() == f.bgr.size());
   VARSLAM_FUZZ_EXPECT(f.depth.type() == CV_32FC1);
   for (int y = 0; y < f.depth.rows; ++y)
     for (int x = 0; x < f.depth.cols; ++x) {

@@ -9,8 +9,7 @@
 #include "io/settings.hpp"
 #include "io/settings_registry.hpp"
 
-extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data,
-                                      std::size_t size) {
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace varslam;
   std::vector<std::string> overrides(1);
   for (std::size_t i = 0; i < size; ++i) {
@@ -22,7 +21,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data,
   Settings s = default_settings();
   try {
     apply_setting_overrides(s, overrides);
-  } catch (const InputError &) {
+  } catch (const InputError&) {
     return 0;
   }
   VARSLAM_FUZZ_EXPECT(std::isfinite(s.camera.fx) && s.camera.fx > 0);

@@ -7,14 +7,13 @@
 #include "fuzz_input.hpp"
 #include "io/settings.hpp"
 
-extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data,
-                                      std::size_t size) {
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace varslam;
   const auto file = fuzz::write_input("settings.yaml", data, size);
   Settings s;
   try {
     s = load_settings(file);
-  } catch (const InputError &) {
+  } catch (const InputError&) {
     return 0;
   }
   VARSLAM_FUZZ_EXPECT(std::isfinite(s.camera.fx) && s.camera.fx > 0);
@@ -25,9 +24,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data,
   const auto again = fuzz::scratch_dir() / "settings_again.yaml";
   save_settings(s, again);
   const Settings t = load_settings(again);
-  VARSLAM_FUZZ_EXPECT(t.camera.fx == s.camera.fx &&
-                      t.camera.width == s.camera.width);
-  VARSLAM_FUZZ_EXPECT(t.depth_factor == s.depth_factor &&
-                      t.orb.n_features == s.orb.n_features);
+  VARSLAM_FUZZ_EXPECT(t.camera.fx == s.camera.fx && t.camera.width == s.camera.width);
+  VARSLAM_FUZZ_EXPECT(t.depth_factor == s.depth_factor && t.orb.n_features == s.orb.n_features);
   return 0;
 }

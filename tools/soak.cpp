@@ -11,6 +11,7 @@
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -24,7 +25,6 @@
 #include "io/settings_registry.hpp"
 #include "io/trajectory_io.hpp"
 #include "pipeline/slam.hpp"
-#include "run/metrics_recorder.hpp"
 
 namespace {
 
@@ -32,12 +32,11 @@ using Clock = std::chrono::steady_clock;
 
 // A /proc/self/status field in MiB ("VmHWM", "VmRSS"); -1 where the kernel does
 // not give it.
-double status_mib(const std::string &field) {
+double status_mib(const std::string& field) {
   std::ifstream in("/proc/self/status");
   std::string line;
   while (std::getline(in, line))
-    if (line.rfind(field + ":", 0) == 0)
-      return std::stod(line.substr(field.size() + 1)) / 1024.0;
+    if (line.rfind(field + ":", 0) == 0) return std::stod(line.substr(field.size() + 1)) / 1024.0;
   return -1;
 }
 
@@ -46,46 +45,41 @@ double status_mib(const std::string &field) {
 void reset_peak_rss() { std::ofstream("/proc/self/clear_refs") << "5"; }
 
 // FNV-1a over the trajectory's printed form: equal text, equal hash.
-std::string trajectory_hash(const varslam::Trajectory &t) {
+std::string trajectory_hash(const varslam::Trajectory& t) {
   std::uint64_t h = 1469598103934665603ull;
-  for (const auto &p : t) {
-    const auto &x = p.T_wc.matrix();
-    const std::string s = fmt::format(
-        "{:.6f} {:.9g} {:.9g} {:.9g} {:.9g} {:.9g} {:.9g}", p.timestamp,
-        x(0, 3), x(1, 3), x(2, 3), x(0, 0), x(1, 1), x(2, 2));
-    for (unsigned char c : s)
-      h = (h ^ c) * 1099511628211ull;
+  for (const auto& p : t) {
+    const auto& x = p.T_wc.matrix();
+    const std::string s = fmt::format("{:.6f} {:.9g} {:.9g} {:.9g} {:.9g} {:.9g} {:.9g}", p.timestamp, x(0, 3), x(1, 3),
+                                      x(2, 3), x(0, 0), x(1, 1), x(2, 2));
+    for (unsigned char c : s) h = (h ^ c) * 1099511628211ull;
   }
   return fmt::format("{:016x}", h);
 }
 
 double median(std::vector<double> v) {
-  return varslam::run::median_p95(std::move(v)).first;
+  if (v.empty()) return 0;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+  return v[v.size() / 2];
 }
 
-nlohmann::json one_run(const varslam::Dataset &dataset,
-                       const varslam::Settings &settings,
-                       const std::optional<varslam::Trajectory> &gt) {
+nlohmann::json one_run(const varslam::Dataset& dataset, const varslam::Settings& settings,
+                       const std::optional<varslam::Trajectory>& gt) {
   using namespace varslam;
   reset_peak_rss();
   const auto t0 = Clock::now();
   Slam slam(settings);
-  std::vector<RgbdFrame>
-      samples; // as the CLI does: 10 frames spread over the first 300
+  std::vector<RgbdFrame> samples;  // as the CLI does: 10 frames spread over the first 300
   if (slam.wants_depth_samples())
     for (std::size_t k = 0; k < 10; ++k)
-      samples.push_back(
-          dataset.load(k * std::min<std::size_t>(dataset.size(), 300) / 10));
+      samples.push_back(dataset.load(k * std::min<std::size_t>(dataset.size(), 300) / 10));
   slam.calibrate_depth(samples);
-  FramePrefetcher prefetch(dataset, 4, 0, dataset.size(),
-                           slam.frame_preparation());
+  FramePrefetcher prefetch(dataset, 4, 0, dataset.size(), slam.frame_preparation());
   std::vector<double> track_ms;
   std::size_t tracked = 0;
   while (auto frame = prefetch.next()) {
     const auto t = Clock::now();
     const FrameResult r = slam.track(*frame);
-    track_ms.push_back(
-        std::chrono::duration<double, std::milli>(Clock::now() - t).count());
+    track_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t).count());
     tracked += r.T_wc.has_value();
   }
   slam.finish();
@@ -98,16 +92,13 @@ nlohmann::json one_run(const varslam::Dataset &dataset,
       {"map_points", slam.summary().map_points},
       {"wall_s", std::chrono::duration<double>(Clock::now() - t0).count()},
       {"track_median_ms", median(track_ms)},
-      {"track_median_first_third_ms",
-       median({track_ms.begin(), track_ms.begin() + third})},
-      {"track_median_last_third_ms",
-       median({track_ms.end() - third, track_ms.end()})},
+      {"track_median_first_third_ms", median({track_ms.begin(), track_ms.begin() + third})},
+      {"track_median_last_third_ms", median({track_ms.end() - third, track_ms.end()})},
       {"peak_rss_mib", status_mib("VmHWM")},
       {"trajectory_hash", trajectory_hash(final_traj)},
   };
   if (gt && final_traj.size() >= 2) {
-    const AteResult fin = evaluate_ate(*gt, final_traj),
-                    live = evaluate_ate(*gt, slam.live_trajectory());
+    const AteResult fin = evaluate_ate(*gt, final_traj), live = evaluate_ate(*gt, slam.live_trajectory());
     j["ate_final_cm"] = 100 * fin.stats.rmse;
     j["ate_final_max_cm"] = 100 * fin.stats.max;
     j["ate_live_cm"] = 100 * live.stats.rmse;
@@ -116,11 +107,12 @@ nlohmann::json one_run(const varslam::Dataset &dataset,
   return j;
 }
 
-} // namespace
+}  // namespace
 
-int main(int argc, char **argv) {
-  CLI::App app{"Runs one sequence repeatedly in one process through the "
-               "pipeline API and reports memory and time"};
+int main(int argc, char** argv) {
+  CLI::App app{
+      "Runs one sequence repeatedly in one process through the "
+      "pipeline API and reports memory and time"};
   std::string dataset_dir, json_file;
   int runs = 10;
   std::vector<std::string> overrides;
@@ -136,12 +128,12 @@ int main(int argc, char **argv) {
     apply_setting_overrides(settings, overrides);
     const auto dataset = open_dataset(dataset_dir, settings);
     std::optional<Trajectory> gt;
-    if (dataset->groundtruth())
-      gt = read_tum_trajectory(*dataset->groundtruth());
+    if (dataset->groundtruth()) gt = read_tum_trajectory(*dataset->groundtruth());
     nlohmann::json all = nlohmann::json::array();
-    fmt::print("run  frames tracked  wall_s  track_ms(med first/last third)  "
-               "peak_MiB rss_after_MiB  ATE final/max  "
-               "live/max (cm)  hash\n");
+    fmt::print(
+        "run  frames tracked  wall_s  track_ms(med first/last third)  "
+        "peak_MiB rss_after_MiB  ATE final/max  "
+        "live/max (cm)  hash\n");
     for (int k = 0; k < runs; ++k) {
       nlohmann::json j = one_run(*dataset, settings, gt);
       j["rss_after_mib"] = status_mib("VmRSS");
@@ -149,20 +141,16 @@ int main(int argc, char **argv) {
           "{:3d} {:7d} {:7d} {:7.1f}  {:6.2f} ({:6.2f} / {:6.2f})           "
           "{:8.0f} {:13.0f}  {:5.2f}/{:6.2f}  "
           "{:5.2f}/{:6.2f}  {}\n",
-          k + 1, j["frames"].get<int>(), j["tracked"].get<int>(),
-          j["wall_s"].get<double>(), j["track_median_ms"].get<double>(),
-          j["track_median_first_third_ms"].get<double>(),
-          j["track_median_last_third_ms"].get<double>(),
-          j["peak_rss_mib"].get<double>(), j["rss_after_mib"].get<double>(),
-          j.value("ate_final_cm", -1.0), j.value("ate_final_max_cm", -1.0),
-          j.value("ate_live_cm", -1.0), j.value("ate_live_max_cm", -1.0),
-          j["trajectory_hash"].get<std::string>());
+          k + 1, j["frames"].get<int>(), j["tracked"].get<int>(), j["wall_s"].get<double>(),
+          j["track_median_ms"].get<double>(), j["track_median_first_third_ms"].get<double>(),
+          j["track_median_last_third_ms"].get<double>(), j["peak_rss_mib"].get<double>(),
+          j["rss_after_mib"].get<double>(), j.value("ate_final_cm", -1.0), j.value("ate_final_max_cm", -1.0),
+          j.value("ate_live_cm", -1.0), j.value("ate_live_max_cm", -1.0), j["trajectory_hash"].get<std::string>());
       std::fflush(stdout);
       all.push_back(j);
     }
-    if (!json_file.empty())
-      std::ofstream(json_file) << all.dump(2) << "\n";
-  } catch (const varslam::InputError &e) {
+    if (!json_file.empty()) std::ofstream(json_file) << all.dump(2) << "\n";
+  } catch (const varslam::InputError& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return 2;
   }

@@ -9,6 +9,7 @@
 #include "eval/eval_report.hpp"
 #include "io/frame_list.hpp"
 #include "io/trajectory_io.hpp"
+#include "mapfile/map_file.hpp"
 
 namespace varslam::cli {
 namespace {
@@ -25,6 +26,7 @@ struct EvalArgs {
   bool per_pair = false;
   std::optional<std::size_t> frame_count;
   std::string frame_list;
+  std::string map;
 };
 
 void run_eval(const EvalArgs& a) {
@@ -35,6 +37,17 @@ void run_eval(const EvalArgs& a) {
   options.ate.offset = a.offset;
   options.ate.with_scale = a.scale;
   options.rpe_delta_seconds = a.delta;
+  if (!a.map.empty()) {
+    // A run localized in a saved map, measured in that map's own alignment to ground truth.
+    const mapfile::SavedMap m = mapfile::load_map_file(a.map);
+    if (!m.groundtruth_alignment)
+      throw InputError(a.map + ": the map has no alignment to ground truth (the run that built it had none)");
+    if (a.scale) throw InputError("--map and --scale: the map's alignment is rigid");
+    Alignment fixed;
+    fixed.R = m.groundtruth_alignment->linear();
+    fixed.t = m.groundtruth_alignment->translation();
+    options.ate.fixed_alignment = fixed;
+  }
   options.frame_count = a.frame_count;
   if (!a.frame_list.empty()) {
     // Frames that could have been evaluated: those with ground truth in reach.
@@ -76,6 +89,9 @@ void add_eval_command(CLI::App& app) {
   cmd->add_option("--max-diff", args->max_diff, "Association window in seconds (strict)")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  cmd->add_option("--map", args->map,
+                  "Evaluate in this saved map's alignment to ground truth instead of a fresh one (a run localized in "
+                  "the map)");
   cmd->add_option("--offset", args->offset, "Seconds added to the estimate's timestamps")->capture_default_str();
   cmd->add_option("--delta", args->delta, "RPE interval in seconds")->capture_default_str()->check(CLI::PositiveNumber);
   cmd->add_flag("--scale", args->scale, "Align with scale (Sim(3), for monocular estimates)");

@@ -3,7 +3,10 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <array>
 #include <atomic>
+#include <cstring>
+#include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
@@ -68,12 +71,14 @@ class ListedRgbdDataset final : public Dataset {
     out.depth_path = (root_ / f.depth.path).string();
 
     check_exists(f.rgb, out.rgb_path);
+    check_image_format(f.rgb, out.rgb_path);
     out.bgr = cv::imread(out.rgb_path, cv::IMREAD_COLOR);
     if (out.bgr.empty()) throw InputError(fmt::format("{}: cannot decode image {}", f.rgb.where, out.rgb_path));
     check_size(out.bgr, f.rgb, out.rgb_path);
     cv::cvtColor(out.bgr, out.gray, cv::COLOR_BGR2GRAY);
 
     check_exists(f.depth, out.depth_path);
+    check_image_format(f.depth, out.depth_path);
     const cv::Mat raw = cv::imread(out.depth_path, cv::IMREAD_UNCHANGED);
     if (raw.empty())
       throw InputError(fmt::format("{}: cannot decode depth image {}", f.depth.where, out.depth_path));
@@ -101,6 +106,20 @@ class ListedRgbdDataset final : public Dataset {
  private:
   static void check_exists(const ListEntry& e, const std::string& path) {
     if (!fs::exists(path)) throw InputError(fmt::format("{}: listed image {} does not exist", e.where, path));
+  }
+
+  // OpenCV picks a decoder by the file's content, whatever its name, and some it links abort on malformed input
+  // (its DICOM reader asserts; found by fuzzing): only PNG and JPEG files, the formats RGB-D datasets use, reach it.
+  static void check_image_format(const ListEntry& e, const std::string& path) {
+    std::array<unsigned char, 132> head{};
+    std::ifstream in(path, std::ios::binary);
+    in.read(reinterpret_cast<char*>(head.data()), head.size());
+    const auto n = static_cast<std::size_t>(in.gcount());
+    const bool png = n >= 8 && std::memcmp(head.data(), "\x89PNG\r\n\x1a\n", 8) == 0;
+    const bool jpeg = n >= 3 && head[0] == 0xFF && head[1] == 0xD8 && head[2] == 0xFF;
+    const bool dicom = n >= 132 && std::memcmp(head.data() + 128, "DICM", 4) == 0;  // tried before PNG/JPEG
+    if ((png || jpeg) && !dicom) return;
+    throw InputError(fmt::format("{}: {} is not a PNG or JPEG image", e.where, path));
   }
 
   void check_size(const cv::Mat& img, const ListEntry& e, const std::string& path) const {

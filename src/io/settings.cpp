@@ -30,6 +30,14 @@ std::string read_yaml_text(const std::filesystem::path& file) {
 
 // What the registry's per-key ranges cannot say: relations between keys.
 void check_relations(const Settings& s) {
+  const std::string where = s.source.empty() ? std::string("<settings>") : s.source.string();
+  // camera.bf defaults to a Kinect's 40 whatever camera.fx is; what it means is the baseline bf / fx.
+  const double baseline = s.camera.bf / s.camera.fx;
+  constexpr double kMaxBaseline = 10.0;  // camera.baseline's range
+  if (!(baseline > 0 && baseline <= kMaxBaseline))
+    throw ConfigError(fmt::format("{}: camera.bf {} with camera.fx {} is a baseline of {:g} m (at most {:g}); give "
+                                  "camera.baseline in metres",
+                                  where, s.camera.bf, s.camera.fx, baseline, kMaxBaseline));
   const auto& o = s.orb;
   if (o.min_th_fast > o.ini_th_fast)
     throw ConfigError(fmt::format("{}: orb.min_th_fast ({}) must not exceed orb.ini_th_fast ({})",

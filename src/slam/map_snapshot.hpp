@@ -16,12 +16,10 @@ using mapfile::SavedMap;
 
 /// The live map as plain records (keyframes and points that are not bad; links
 /// to culled keyframes dropped).
-SavedMap snapshot_map(const Map &map, const KeyframeDatabase &places,
-                      MapFingerprint fingerprint, long next_frame_id);
+SavedMap snapshot_map(const Map& map, const KeyframeDatabase& places, MapFingerprint fingerprint, long next_frame_id);
 
 /// Builds keyframes and points from the records into `map` (which must be
 /// empty) and `places`; new keyframes and points get ids after the loaded ones.
-void restore_map(const SavedMap &saved, Map &map, KeyframeDatabase &places,
-                 std::shared_ptr<const ScaleInfo> scale);
+void restore_map(const SavedMap& saved, Map& map, KeyframeDatabase& places, std::shared_ptr<const ScaleInfo> scale);
 
-} // namespace varslam::slam
+}  // namespace varslam::slam

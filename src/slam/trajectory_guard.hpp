@@ -12,7 +12,7 @@ namespace varslam::slam {
 /// it) differs from its neighbours' for a reason other than Local BA and loop
 /// bends, which move consecutive frames alike: the "dragged" threshold of the
 /// benchmarks.
-inline constexpr double kIsolatedCorrection = 0.10; // m
+inline constexpr double kIsolatedCorrection = 0.10;  // m
 
 /// `final_poses[i]` and `live_T_wc[i]` are one frame's final and live poses, in
 /// frame order. A frame whose final pose moved apart from both neighbours (its
@@ -23,7 +23,6 @@ inline constexpr double kIsolatedCorrection = 0.10; // m
 /// lone keyframe left misplaced by an optimisation (then culled with that pose)
 /// must not reach the trajectory, while a frame tracking got wrong and Local BA
 /// set right keeps its final pose. Returns how many poses were replaced.
-int repair_isolated_poses(Trajectory &final_poses,
-                          const std::vector<Eigen::Isometry3d> &live_T_wc);
+int repair_isolated_poses(Trajectory& final_poses, const std::vector<Eigen::Isometry3d>& live_T_wc);
 
-} // namespace varslam::slam
+}  // namespace varslam::slam

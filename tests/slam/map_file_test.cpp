@@ -33,25 +33,21 @@ fs::path static_sequence() {
   return e2e::cached_sequence("map_static_4s", cfg);
 }
 
-fs::path temp_path(const std::string &name) {
-  return fs::temp_directory_path() /
-         ("varslam_map_" + name + "_" + std::to_string(::getpid()));
+fs::path temp_path(const std::string& name) {
+  return fs::temp_directory_path() / ("varslam_map_" + name + "_" + std::to_string(::getpid()));
 }
 
-std::string bytes_of(const fs::path &p) {
+std::string bytes_of(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
   std::stringstream ss;
   ss << in.rdbuf();
   return ss.str();
 }
 
-run::RunSummary run_frames(std::size_t first, std::size_t count,
-                           const std::string &name,
-                           const std::optional<fs::path> &load = std::nullopt,
-                           bool localization_only = false,
-                           const std::optional<fs::path> &save = std::nullopt,
-                           const std::vector<std::string> &overrides = {},
-                           fs::path data = static_sequence()) {
+run::RunSummary run_frames(std::size_t first, std::size_t count, const std::string& name,
+                           const std::optional<fs::path>& load = std::nullopt, bool localization_only = false,
+                           const std::optional<fs::path>& save = std::nullopt,
+                           const std::vector<std::string>& overrides = {}, fs::path data = static_sequence()) {
   Settings settings = settings_for_dataset(data, std::nullopt);
   apply_setting_overrides(settings, overrides);
   auto ds = open_dataset(data, settings);
@@ -70,7 +66,7 @@ run::RunSummary run_frames(std::size_t first, std::size_t count,
 
 // One map of the first 90 frames (3 keyframes), shared by the tests of this
 // file.
-const fs::path &saved_map() {
+const fs::path& saved_map() {
   static const fs::path file = [] {
     const fs::path f = temp_path("first90.map");
     run_frames(0, 90, "first90", std::nullopt, false, f);
@@ -79,10 +75,10 @@ const fs::path &saved_map() {
   return file;
 }
 
-std::string decode_error(const std::string &bytes) {
+std::string decode_error(const std::string& bytes) {
   try {
     decode_map(bytes, "test.map");
-  } catch (const InputError &e) {
+  } catch (const InputError& e) {
     return e.what();
   }
   ADD_FAILURE() << "decoded without an error";
@@ -93,32 +89,30 @@ TEST(MapFile, SavedMapHasTheRunsKeyframesPointsAndGraph) {
   const SavedMap m = load_map_file(saved_map());
   ASSERT_GE(m.keyframes.size(), 3u);
   EXPECT_GE(m.map_points.size(), 400u);
-  EXPECT_TRUE(m.groundtruth_alignment.has_value()); // the run had ground truth
+  EXPECT_TRUE(m.groundtruth_alignment.has_value());  // the run had ground truth
   EXPECT_EQ(m.fingerprint.camera.width, 640);
   EXPECT_THAT(m.fingerprint.settings_yaml, HasSubstr("camera:"));
   int roots = 0, with_connections = 0;
-  for (const auto &k : m.keyframes) {
+  for (const auto& k : m.keyframes) {
     roots += k.parent == -1;
     with_connections += !k.connections.empty();
     EXPECT_EQ(k.descriptors.rows, static_cast<int>(k.keypoints.size()));
     EXPECT_GT(k.signature.rows, 0);
     EXPECT_EQ(k.segment, 1);
   }
-  EXPECT_EQ(roots, 1); // one segment: one spanning tree
+  EXPECT_EQ(roots, 1);  // one segment: one spanning tree
   EXPECT_EQ(with_connections, static_cast<int>(m.keyframes.size()));
 }
 
 TEST(MapFile, SaveLoadSaveGivesTheSameBytes) {
   const std::string first = bytes_of(saved_map());
   const SavedMap saved = decode_map(first, saved_map().string());
-  EXPECT_EQ(encode_map(saved), first); // the codec alone
+  EXPECT_EQ(encode_map(saved), first);  // the codec alone
 
   // Through the live map: restored into a system and snapshotted again.
-  const Settings settings =
-      settings_for_dataset(static_sequence(), std::nullopt);
+  const Settings settings = settings_for_dataset(static_sequence(), std::nullopt);
   const SlamConfig cfg = slam_config_from(settings);
-  System system(cfg, settings.camera, settings.close_depth_m(),
-                RunMode::Deterministic);
+  System system(cfg, settings.camera, settings.close_depth_m(), RunMode::Deterministic);
   system.adopt_map(saved);
   SavedMap again = system.snapshot(saved.fingerprint);
   again.groundtruth_alignment = saved.groundtruth_alignment;
@@ -128,10 +122,8 @@ TEST(MapFile, SaveLoadSaveGivesTheSameBytes) {
 TEST(MapFile, BrokenOrForeignFilesAreRefusedByName) {
   const std::string good = bytes_of(saved_map());
   EXPECT_THAT(decode_error(""), HasSubstr("not a varslam map"));
-  EXPECT_THAT(decode_error("camera:\n  fx: 500\n"),
-              HasSubstr("not a varslam map"));
-  EXPECT_THAT(decode_error(good.substr(0, good.size() / 2)),
-              HasSubstr("truncated or corrupted"));
+  EXPECT_THAT(decode_error("camera:\n  fx: 500\n"), HasSubstr("not a varslam map"));
+  EXPECT_THAT(decode_error(good.substr(0, good.size() / 2)), HasSubstr("truncated or corrupted"));
   std::string flipped = good;
   flipped[flipped.size() - 100] ^= 0x5a;
   EXPECT_THAT(decode_error(flipped), HasSubstr("checksum"));
@@ -140,15 +132,13 @@ TEST(MapFile, BrokenOrForeignFilesAreRefusedByName) {
   json outer = json::from_cbor(good.begin() + 8, good.end());
   outer["version"] = kMapFormatVersion + 1;
   const auto v2 = json::to_cbor(outer);
-  EXPECT_THAT(
-      decode_error(good.substr(0, 8) + std::string(v2.begin(), v2.end())),
-      HasSubstr(fmt::format("map format version {}", kMapFormatVersion + 1)));
+  EXPECT_THAT(decode_error(good.substr(0, 8) + std::string(v2.begin(), v2.end())),
+              HasSubstr(fmt::format("map format version {}", kMapFormatVersion + 1)));
 
   // Well-formed bytes whose records do not hold together.
   SavedMap m = decode_map(good, "good");
   m.map_points.front().reference_keyframe = 999999;
-  EXPECT_THAT(decode_error(encode_map(m)),
-              HasSubstr("reference keyframe not in the map"));
+  EXPECT_THAT(decode_error(encode_map(m)), HasSubstr("reference keyframe not in the map"));
   m = decode_map(good, "good");
   m.keyframes.front().points.front().first = 1 << 20;
   EXPECT_THAT(decode_error(encode_map(m)), HasSubstr(".points"));
@@ -162,29 +152,21 @@ TEST(MapFile, BrokenOrForeignFilesAreRefusedByName) {
 TEST(MapFile, AnotherCameraOrPyramidIsRefused) {
   const SavedMap m = load_map_file(saved_map());
   PinholeCamera cam = m.fingerprint.camera;
-  EXPECT_NO_THROW(check_map_compatible(m.fingerprint, cam,
-                                       m.fingerprint.n_levels,
-                                       m.fingerprint.scale_factor, "x"));
-  cam.fx *= 1.005; // within 1 %: the same sensor recalibrated
-  EXPECT_NO_THROW(check_map_compatible(m.fingerprint, cam,
-                                       m.fingerprint.n_levels,
-                                       m.fingerprint.scale_factor, "x"));
+  EXPECT_NO_THROW(check_map_compatible(m.fingerprint, cam, m.fingerprint.n_levels, m.fingerprint.scale_factor, "x"));
+  cam.fx *= 1.005;  // within 1 %: the same sensor recalibrated
+  EXPECT_NO_THROW(check_map_compatible(m.fingerprint, cam, m.fingerprint.n_levels, m.fingerprint.scale_factor, "x"));
   cam.fx *= 1.05;
   try {
-    check_map_compatible(m.fingerprint, cam, m.fingerprint.n_levels,
-                         m.fingerprint.scale_factor, "k.map");
+    check_map_compatible(m.fingerprint, cam, m.fingerprint.n_levels, m.fingerprint.scale_factor, "k.map");
     ADD_FAILURE();
-  } catch (const InputError &e) {
-    EXPECT_THAT(e.what(),
-                HasSubstr("k.map: the map was built with another camera"));
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("k.map: the map was built with another camera"));
   }
   cam = m.fingerprint.camera;
   cam.width = 320;
-  EXPECT_THROW(check_map_compatible(m.fingerprint, cam, m.fingerprint.n_levels,
-                                    m.fingerprint.scale_factor, "x"),
+  EXPECT_THROW(check_map_compatible(m.fingerprint, cam, m.fingerprint.n_levels, m.fingerprint.scale_factor, "x"),
                InputError);
-  EXPECT_THROW(check_map_compatible(m.fingerprint, m.fingerprint.camera, 4,
-                                    m.fingerprint.scale_factor, "x"),
+  EXPECT_THROW(check_map_compatible(m.fingerprint, m.fingerprint.camera, 4, m.fingerprint.scale_factor, "x"),
                InputError);
 }
 
@@ -193,27 +175,34 @@ TEST(MapFile, LocalizationOnlyTracksInTheLoadedMapWithoutExtendingIt) {
   const run::RunSummary s = run_frames(90, 30, "localize", saved_map(), true);
   EXPECT_EQ(s.frames, 30u);
   EXPECT_GE(s.tracked, 29u);
-  EXPECT_EQ(s.keyframes, m.keyframes.size()); // nothing added
+  EXPECT_EQ(s.keyframes, m.keyframes.size());  // nothing added
   EXPECT_EQ(s.metrics["relocalizations"].get<int>(), 1);
   ASSERT_TRUE(s.ate_map_frame_rmse.has_value());
-  EXPECT_LT(*s.ate_map_frame_rmse,
-            0.03); // in the map's own alignment, not a fresh one
+  EXPECT_LT(*s.ate_map_frame_rmse, 0.03);  // in the map's own alignment, not a fresh one
+
+  // `varslam eval --map` gives the same figure from the files.
+  const fs::path json = temp_path("eval_map.json");
+  const std::string cmd = std::string(VARSLAM_BINARY_DIR) + "/bin/varslam eval --gt " +
+                          (static_sequence() / "groundtruth.txt").string() + " --est " +
+                          (s.out_dir / "CameraTrajectory.txt").string() + " --map " + saved_map().string() +
+                          " --json " + json.string() + " > /dev/null";
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  const auto j = nlohmann::json::parse(bytes_of(json));
+  EXPECT_NEAR(j["ate"]["rmse"].get<double>(), *s.ate_map_frame_rmse, 1e-9);
 }
 
 TEST(MapFile, MappingOnALoadedMapExtendsItAfterTheLoadedIds) {
   const SavedMap m = load_map_file(saved_map());
   const fs::path extended = temp_path("extended.map");
-  const run::RunSummary s =
-      run_frames(90, 30, "extend", saved_map(), false, extended);
+  const run::RunSummary s = run_frames(90, 30, "extend", saved_map(), false, extended);
   EXPECT_GE(s.tracked, 29u);
-  EXPECT_EQ(s.segments, 1); // relocalized in the loaded segment, no new one
+  EXPECT_EQ(s.segments, 1);  // relocalized in the loaded segment, no new one
   const SavedMap e = load_map_file(extended);
   EXPECT_GT(e.keyframes.size(), m.keyframes.size());
   EXPECT_GE(e.keyframes.back().id, m.next_keyframe_id);
   EXPECT_GE(e.keyframes.back().frame_id, m.next_frame_id);
   ASSERT_TRUE(e.groundtruth_alignment.has_value());
-  EXPECT_TRUE(e.groundtruth_alignment->isApprox(
-      *m.groundtruth_alignment)); // still the first run's frame
+  EXPECT_TRUE(e.groundtruth_alignment->isApprox(*m.groundtruth_alignment));  // still the first run's frame
 }
 
 TEST(MapFile, AMapOfAnotherPlaceGivesANewSegmentAfterThePatience) {
@@ -221,15 +210,13 @@ TEST(MapFile, AMapOfAnotherPlaceGivesANewSegmentAfterThePatience) {
   cfg.scenario = "static";
   cfg.seconds = 1.0;
   cfg.seed = 9;
-  cfg.path_start = 12; // another stretch of the path: other views
+  cfg.path_start = 12;  // another stretch of the path: other views
   const fs::path elsewhere = e2e::cached_sequence("map_elsewhere", cfg);
-  const run::RunSummary s =
-      run_frames(0, 30, "elsewhere", saved_map(), false, std::nullopt,
-                 {"relocalization.loaded_map_patience=5"}, elsewhere);
-  EXPECT_EQ(s.segments,
-            2); // the loaded one, and the one started after 5 failed frames
+  const run::RunSummary s = run_frames(0, 30, "elsewhere", saved_map(), false, std::nullopt,
+                                       {"relocalization.loaded_map_patience=5"}, elsewhere);
+  EXPECT_EQ(s.segments, 2);  // the loaded one, and the one started after 5 failed frames
   EXPECT_GE(s.tracked, 20u);
 }
 
-} // namespace
-} // namespace varslam::slam
+}  // namespace
+}  // namespace varslam::slam
