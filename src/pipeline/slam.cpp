@@ -340,7 +340,10 @@ void Slam::save_map(const std::filesystem::path& file, const std::optional<Eigen
   mapfile::save_map_file(m, file);
 }
 
-Trajectory Slam::camera_trajectory() const { return system_ ? system_->camera_trajectory() : Trajectory{}; }
+Trajectory Slam::camera_trajectory(int* repaired) const {
+  if (repaired) *repaired = 0;
+  return system_ ? system_->camera_trajectory(false, repaired) : Trajectory{};
+}
 
 Trajectory Slam::keyframe_trajectory() const { return system_ ? system_->keyframe_trajectory() : Trajectory{}; }
 
@@ -355,7 +358,6 @@ SlamSummary Slam::summary() const {
     s.map_points = system_->map().num_map_points();
     s.segments = system_->tracker().segments();
     s.relocalizations = system_->tracker().relocalizations();
-    system_->camera_trajectory(false, &s.final_poses_repaired);
   }
   s.detector = masker_ ? masker_->detector_name() : "none";
   s.detector_runs = masker_ ? masker_->detector_runs() : 0;

@@ -47,7 +47,6 @@ struct SlamOptions {
 struct SlamSummary {
   std::size_t frames = 0, tracked = 0, keyframes = 0, map_points = 0;
   int segments = 0, relocalizations = 0;
-  int final_poses_repaired = 0;  // final poses no frame supported, replaced (slam/trajectory_guard.hpp)
   std::string detector;        // "none" without the person filter
   long detector_runs = 0;
   bool detector_asynchronous = false;
@@ -102,7 +101,8 @@ class Slam {
   void finish();
 
   /// Camera-to-world pose of every tracked frame, after every correction so far (BA, loops).
-  Trajectory camera_trajectory() const;
+  /// `repaired` (optional) gets how many final poses no frame supported were replaced (slam/trajectory_guard.hpp).
+  Trajectory camera_trajectory(int* repaired = nullptr) const;
   /// Each pose as tracking gave it (what a live user got).
   const Trajectory& live_trajectory() const { return live_; }
   Trajectory keyframe_trajectory() const;

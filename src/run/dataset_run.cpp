@@ -239,17 +239,19 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const RunO
   sum.wall_seconds = wall;
   sum.fps = static_cast<double>(sum.frames) / std::max(wall, 1e-9);
 
-  const Trajectory traj = slam.camera_trajectory();
+  int repaired = 0;
+  const Trajectory traj = slam.camera_trajectory(&repaired);
   write_tum_trajectory(traj, out_dir / "CameraTrajectory.txt");
   write_tum_trajectory(slam.keyframe_trajectory(), out_dir / "KeyFrameTrajectory.txt");
   write_tum_trajectory(slam.live_trajectory(), out_dir / "LiveTrajectory.txt");
   write_map_ply(slam.map(), out_dir / "map.ply");
 
   nlohmann::json m = metrics.metrics(slam);
-  if (const int n = m["final_poses_repaired"].get<int>(); n > 0)
+  m["final_poses_repaired"] = repaired;
+  if (repaired > 0)
     spdlog::warn("{} final pose{} no frame supported (a lone keyframe left misplaced) replaced by the neighbours' "
                  "correction of the live pose",
-                 n, n == 1 ? "" : "s");
+                 repaired, repaired == 1 ? "" : "s");
   m["dataset"] = dataset.root().string();
   m["wall_seconds"] = wall;
   m["fps"] = sum.fps;

@@ -31,17 +31,23 @@ inline fs::path cached_sequence(const std::string& name, synth::SynthConfig cfg)
   return d;
 }
 
-/// Runs SLAM with the dataset's settings (plus `overrides`, as --set takes them) and writes into `out`.
-inline run::RunSummary run_on(const fs::path& data, const fs::path& out, RunMode mode = RunMode::Deterministic,
-                         std::size_t max_frames = SIZE_MAX, const std::vector<std::string>& overrides = {}) {
+/// Runs SLAM with the dataset's settings (plus `overrides`, as --set takes them) and these options into `out`.
+inline run::RunSummary run_with(const fs::path& data, const fs::path& out, const run::RunOptions& options,
+                                const std::vector<std::string>& overrides = {}) {
   Settings settings = settings_for_dataset(data, std::nullopt);
   apply_setting_overrides(settings, overrides);
   auto ds = open_dataset(data, settings);
+  return run::run_slam(*ds, settings, options, out);
+}
+
+/// The same with the usual options: no progress line, the given mode and frame count.
+inline run::RunSummary run_on(const fs::path& data, const fs::path& out, RunMode mode = RunMode::Deterministic,
+                         std::size_t max_frames = SIZE_MAX, const std::vector<std::string>& overrides = {}) {
   run::RunOptions ro;
   ro.mode = mode;
   ro.progress = false;
   ro.max_frames = max_frames;
-  return run::run_slam(*ds, settings, ro, out);
+  return run_with(data, out, ro, overrides);
 }
 
 }  // namespace varslam::slam::e2e

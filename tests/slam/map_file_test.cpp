@@ -48,9 +48,6 @@ run::RunSummary run_frames(std::size_t first, std::size_t count, const std::stri
                            const std::optional<fs::path>& load = std::nullopt, bool localization_only = false,
                            const std::optional<fs::path>& save = std::nullopt,
                            const std::vector<std::string>& overrides = {}, fs::path data = static_sequence()) {
-  Settings settings = settings_for_dataset(data, std::nullopt);
-  apply_setting_overrides(settings, overrides);
-  auto ds = open_dataset(data, settings);
   run::RunOptions ro;
   ro.progress = false;
   ro.first = first;
@@ -61,7 +58,7 @@ run::RunSummary run_frames(std::size_t first, std::size_t count, const std::stri
   ro.min_tracked_share = 0;
   const fs::path out = temp_path(name);
   fs::remove_all(out);
-  return run::run_slam(*ds, settings, ro, out);
+  return e2e::run_with(data, out, ro, overrides);
 }
 
 // One map of the first 90 frames (3 keyframes), shared by the tests of this
