@@ -3,7 +3,9 @@
 set -euo pipefail
 PKGS=(build-essential cmake pkg-config ccache libopencv-dev libeigen3-dev libceres-dev libyaml-cpp-dev
       libcli11-dev libfmt-dev libspdlog-dev nlohmann-json3-dev zlib1g-dev libgtest-dev libgmock-dev libbenchmark-dev
-      opencv-doc)
+      opencv-doc libcpp-httplib-dev chromium fonts-dejavu-core)
+# The viewer's build installs three.js with npm; a machine that has node and npm from elsewhere keeps them.
+if ! command -v npm >/dev/null 2>&1; then PKGS+=(nodejs npm); fi
 missing=()
 for p in "${PKGS[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -2,12 +2,37 @@
 
 #include <fmt/format.h>
 
+#include <signal.h>
 #include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <thread>
 
 #include "core/error.hpp"
 #include "report/run_report.hpp"
 
 namespace varslam::cli {
+namespace {
+
+// Set by SIGINT / SIGTERM: the one piece of process-wide state a signal handler needs.
+std::atomic<bool> g_stop_requested{false};
+extern "C" void request_stop(int) { g_stop_requested.store(true); }
+
+}  // namespace
+
+const std::atomic<bool>& stop_on_signals() {
+  struct sigaction sa {};
+  sa.sa_handler = request_stop;
+  sa.sa_flags = SA_RESETHAND;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+  return g_stop_requested;
+}
+
+void wait_for_stop() {
+  while (!g_stop_requested.load()) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+}
 
 void write_report_for_run(const std::filesystem::path& run_dir, const std::filesystem::path& sequence_dir) {
   try {

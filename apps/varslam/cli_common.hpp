@@ -1,5 +1,6 @@
 #pragma once
 // Helpers shared by the subcommands: settings overrides from the command line, summary printing.
+#include <atomic>
 #include <string>
 #include <vector>
 
@@ -11,6 +12,13 @@ namespace varslam::cli {
 
 /// Writes <run>/report.html (plots of the trajectory, error, alpha per keyframe, timings); a failure is a warning.
 void write_report_for_run(const std::filesystem::path& run_dir, const std::filesystem::path& sequence_dir);
+
+/// The first SIGINT or SIGTERM from now on sets the returned flag (a command then ends cleanly, writing what it
+/// has); a second one kills at once.
+const std::atomic<bool>& stop_on_signals();
+
+/// Blocks until stop_on_signals()' flag is set.
+void wait_for_stop();
 
 /// One human-readable block: frames, tracking share, keyframes, speed, ATE, and where the files went.
 void print_run_summary(const run::RunSummary& s);

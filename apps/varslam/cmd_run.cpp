@@ -1,31 +1,20 @@
 // `varslam run`: SLAM over a dataset folder (TUM RGB-D / Bonn / OpenLORIS layouts, or a synthetic sequence).
 #include <fmt/format.h>
-#include <signal.h>
 #include <spdlog/spdlog.h>
 
 #include <atomic>
+#include <chrono>
+#include <thread>
 
 #include "cli_common.hpp"
 #include "core/error.hpp"
 #include "commands.hpp"
 #include "io/dataset.hpp"
+#include "io/trajectory_io.hpp"
+#include "viewer/live_viewer.hpp"
 
 namespace varslam::cli {
 namespace {
-
-// Set by SIGINT / SIGTERM, read by the run loop: the one piece of process-wide state a signal handler needs.
-std::atomic<bool> g_stop_requested{false};
-extern "C" void request_stop(int) { g_stop_requested.store(true); }
-
-// The first SIGINT or SIGTERM ends the run cleanly (what was tracked is written); a second one kills at once.
-void stop_cleanly_on_signals() {
-  struct sigaction sa {};
-  sa.sa_handler = request_stop;
-  sa.sa_flags = SA_RESETHAND;
-  sigemptyset(&sa.sa_mask);
-  sigaction(SIGINT, &sa, nullptr);
-  sigaction(SIGTERM, &sa, nullptr);
-}
 
 // Frame counts and indices: CLI11 would wrap "-1" around to the largest size_t ("all frames").
 const CLI::Validator kCount(
@@ -36,12 +25,37 @@ const CLI::Validator kCount(
     },
     "COUNT");
 
+template <typename Opts>
+std::unique_ptr<viewer::LiveViewer> start_viewer(const Opts& o, const Dataset& dataset, const run::RunOptions& ro) {
+  viewer::LiveViewerOptions vo;
+  vo.server.address = o.viewer_address;
+  vo.server.port = o.viewer_port;
+  vo.title = dataset.root().filename().string();
+  const auto gt = ro.groundtruth ? ro.groundtruth : dataset.groundtruth();
+  if (gt && std::filesystem::exists(*gt)) {
+    try {
+      vo.groundtruth = read_tum_trajectory(*gt);
+    } catch (const InputError&) {
+      // The run reads it too and says what is wrong with it.
+    }
+  }
+  auto v = std::make_unique<viewer::LiveViewer>(vo);
+  if (o.viewer_address != "127.0.0.1" && o.viewer_address != "localhost" && o.viewer_address != "::1")
+    spdlog::warn("viewer: listening on {}, not only this machine: anyone who reaches it sees the run",
+                 o.viewer_address);
+  spdlog::info("viewer: open {} in a browser", v->url());
+  return v;
+}
+
 }  // namespace
 
 void add_run_command(CLI::App& app) {
   struct Opts {
     std::string dataset, settings, out = "out/run", groundtruth, save_map, load_map;
     bool realtime = false, pace = false, quiet = false, localization_only = false;
+    bool viewer = false, viewer_hold = false, viewer_wait = false;
+    std::string viewer_address = "127.0.0.1";
+    int viewer_port = 0;
     std::size_t first = 0, max_frames = SIZE_MAX;
     double min_tracked_share = 0.5;
     std::vector<std::string> overrides;
@@ -65,6 +79,15 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("--load-map", o->load_map, "Start from this saved map: the first frames relocalize in it");
   cmd->add_flag("--localization-only", o->localization_only,
                 "With --load-map: track in the loaded map without extending it (no keyframes, no points)");
+  cmd->add_flag("--viewer", o->viewer, "Watch the run live in a browser (the address is printed on start)");
+  cmd->add_option("--viewer-port", o->viewer_port, "The viewer's port (0: a free one)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 65535));
+  cmd->add_option("--viewer-address", o->viewer_address,
+                  "Listen on this address instead of loopback (reachable from the network: use with care)")
+      ->capture_default_str();
+  cmd->add_flag("--viewer-hold", o->viewer_hold, "Keep the viewer up after the run until Ctrl+C");
+  cmd->add_flag("--viewer-wait", o->viewer_wait, "Start the run only once a browser is connected");
   cmd->add_option("--set", o->overrides, "Override a setting: section.key=value (repeatable)");
   cmd->add_flag("--quiet,-q", o->quiet, "No progress line");
   cmd->add_option("--debug-frames", o->debug_frames,
@@ -90,11 +113,23 @@ void add_run_command(CLI::App& app) {
     if (o->localization_only && !ro.load_map)
       throw InputError("--localization-only needs a map to localize in: give --load-map FILE");
     ro.localization_only = o->localization_only;
-    ro.stop = &g_stop_requested;
-    stop_cleanly_on_signals();
+    ro.stop = &stop_on_signals();
+    std::unique_ptr<viewer::LiveViewer> live_viewer;
+    if (o->viewer) {
+      live_viewer = start_viewer(*o, *dataset, ro);
+      ro.observers.push_back(live_viewer.get());
+      if (o->viewer_wait) {
+        spdlog::info("viewer: waiting for a browser at {}", live_viewer->url());
+        while (live_viewer->clients() == 0 && !ro.stop->load()) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      }
+    }
     const run::RunSummary s = run::run_slam(*dataset, settings, ro, o->out);
     write_report_for_run(s.out_dir, o->dataset);
     print_run_summary(s);
+    if (live_viewer && o->viewer_hold && !s.interrupted) {
+      spdlog::info("viewer: the run is over; {} keeps showing it until Ctrl+C", live_viewer->url());
+      wait_for_stop();
+    }
     if (s.interrupted)
       throw CommandFailed(fmt::format("interrupted after {} frames; what was tracked is in {}", s.frames,
                                       s.out_dir.string()),

@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   varslam::cli::add_bench_command(app);
   varslam::cli::add_report_command(app);
   varslam::cli::add_settings_command(app);
+  varslam::cli::add_view_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -69,6 +69,25 @@ Settings default_settings() {
   return s;
 }
 
+namespace {
+
+/// Settings keys are names. YAML also allows a map or a list as a key; that has no meaning here, and written back
+/// such a key does not read again.
+void check_keys_are_names(const YAML::Node& node, const std::string& name) {
+  if (node.IsMap()) {
+    for (const auto& kv : node) {
+      if (!kv.first.IsScalar())
+        throw ConfigError(fmt::format("{}:{}: a key must be a name, not a {}", name, kv.first.Mark().line + 1,
+                                      kv.first.IsMap() ? "map" : "list"));
+      check_keys_are_names(kv.second, name);
+    }
+  } else if (node.IsSequence()) {
+    for (const auto& item : node) check_keys_are_names(item, name);
+  }
+}
+
+}  // namespace
+
 Settings load_settings(const std::filesystem::path& file) {
   YAML::Node root;
   try {
@@ -87,6 +106,7 @@ Settings settings_from_yaml(const YAML::Node& root, const std::filesystem::path&
   s.overrides = overrides;
   if (!s.root.IsMap())
     throw ConfigError(fmt::format("{}: expected a YAML map of settings at the top level", file.string()));
+  check_keys_are_names(s.root, file.empty() ? std::string("<settings>") : file.string());
   check_settings_document(s.root, file, overrides);
 
   const std::string name = file.empty() ? std::string("<settings>") : file.string();

@@ -4,6 +4,7 @@
 // observer needs no locking of its own; one that does slow work (a viewer, a network sender) should copy what it
 // needs and hand it to its own thread.
 #include <Eigen/Geometry>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -43,10 +44,21 @@ struct DetectionEvent {
   double detector_latency_s = 0;
   bool propagated = false;       // stale boxes were moved onto this frame by optical flow
   Detections boxes;
+  semantic::PersonRegions people;  // the boxes as the filter used them, with each person's depth (0 = unknown)
+  float depth_band_m = 0;          // keypoints within +-band of a person's depth were dropped
   semantic::FilterStats stats;
   std::vector<cv::KeyPoint> keypoints;  // all keypoints of the frame (level-0 pixels)
   std::vector<bool> keep;               // per keypoint: false where the filter dropped it
   cv::Mat bgr;                          // the frame's colour image (shared, not copied: do not write to it)
+};
+
+/// The tracked frame's keypoints and what tracking made of each (a viewer's overlay, debugging).
+struct KeypointsEvent {
+  std::size_t index = 0;  // as FrameResult::index
+  double timestamp = 0;
+  std::shared_ptr<const slam::FrameFeatures> features;  // undistorted positions, depth, on_depth_edge; after the filter
+  std::vector<slam::KeypointFate> fate;                 // per keypoint of `features`
+  cv::Mat image;  // the frame's colour image (gray when only gray was given); shared, do not write to it
 };
 
 /// A frame that became a keyframe.
@@ -73,12 +85,19 @@ struct DepthRegistrationEvent {
   std::optional<PinholeCamera> colour_camera;  // the colour camera estimated (found)
 };
 
+class Slam;
+
 class Observer {
  public:
   virtual ~Observer() = default;
+  /// From Slam::add_observer: the pipeline now observed (its map and trajectories may be read from a callback).
+  virtual void on_added(const Slam&) {}
+  /// From Slam::finish(), last: the map and trajectories are final.
+  virtual void on_finished() {}
   virtual void on_depth_registration(const DepthRegistrationEvent&) {}
   virtual void on_frame(const FrameResult&) {}
   virtual void on_detection(const DetectionEvent&) {}
+  virtual void on_keypoints(const KeypointsEvent&) {}
   virtual void on_keyframe(const KeyframeEvent&) {}
   /// Local mapping finished a keyframe; its Local BA (alpha per iteration, fitted and applied) is in `ba`.
   virtual void on_keyframe_mapped(const slam::KeyframeMapped&) {}

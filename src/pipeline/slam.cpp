@@ -158,7 +158,10 @@ Slam::Slam(const Settings& settings, SlamOptions options)
 
 Slam::~Slam() = default;
 
-void Slam::add_observer(Observer& observer) { observers_.push_back(&observer); }
+void Slam::add_observer(Observer& observer) {
+  observers_.push_back(&observer);
+  observer.on_added(*this);
+}
 
 void Slam::remove_observer(Observer& observer) {
   observers_.erase(std::remove(observers_.begin(), observers_.end(), &observer), observers_.end());
@@ -202,6 +205,8 @@ void Slam::install_person_filter() {
     d.propagated = r.propagated;
     d.boxes = std::move(r.boxes);
     d.stats = r.stats;
+    d.people = std::move(r.people);
+    d.depth_band_m = semantic_.filter.depth_band_m;
     d.keypoints = kps;
     d.keep = r.keep;
     d.bgr = f.bgr;
@@ -270,6 +275,9 @@ FrameResult Slam::track(const RgbdFrame& input, const std::optional<Detections>&
     detection_->index = r.index;
     emit(*std::exchange(detection_, std::nullopt), &Observer::on_detection);
   }
+  if (!observers_.empty() && out.features)
+    emit(KeypointsEvent{r.index, r.timestamp, out.features, out.keypoint_fate, frame.bgr.empty() ? frame.gray : frame.bgr},
+         &Observer::on_keypoints);
   if (out.relocalized) emit(RelocalizationEvent{r.index, r.timestamp, *out.relocalized}, &Observer::on_relocalization);
   if (out.keyframe && out.live_T_wc)
     emit(KeyframeEvent{out.keyframe_id, r.index, r.timestamp, *out.live_T_wc}, &Observer::on_keyframe);
@@ -296,6 +304,8 @@ void Slam::finish() {
     throw;
   }
   deliver_queued();
+  const std::vector<Observer*> observers = observers_;
+  for (Observer* o : observers) o->on_finished();
 }
 
 void Slam::load_map(const std::filesystem::path& file) {

@@ -79,6 +79,7 @@ MaskResult DynamicKeypointMasker::process(const RgbdFrame& frame, const std::vec
   boxes_for(frame);
   MaskResult out = current_;
   out.keep = filter_keypoints(kps, frame.depth, people_, settings_.filter, &out.stats);
+  out.people = people_;
   return out;
 }
 

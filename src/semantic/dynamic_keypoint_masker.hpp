@@ -20,6 +20,7 @@ struct MaskResult {
   double staleness_s = 0.0;    // frame time - time of the image the boxes were detected in
   double detector_latency_s = 0.0;
   bool propagated = false;
+  PersonRegions people;  // the boxes as the filter used them (enlarged, clipped) with each person's depth
 };
 
 class DynamicKeypointMasker {

@@ -57,6 +57,7 @@ std::shared_ptr<FrameFeatures> make_frame_features(std::vector<cv::KeyPoint> key
   const std::size_t n = keypoints.size();
   f->depth.assign(n, -1.0f);
   f->u_right.assign(n, -1.0f);
+  f->on_depth_edge.assign(n, 0);
   // Depth is looked up at the distorted pixel (where the sensor measured it), then positions are undistorted.
   for (std::size_t i = 0; i < n; ++i) {
     const int u = static_cast<int>(std::lround(keypoints[i].pt.x));
@@ -64,8 +65,12 @@ std::shared_ptr<FrameFeatures> make_frame_features(std::vector<cv::KeyPoint> key
     if (!depth_m.empty() && u >= 0 && v >= 0 && u < depth_m.cols && v < depth_m.rows) {
       const float d = depth_m.at<float>(v, u);
       if (d > 0.0f && std::isfinite(d)) {
-        if (depth_edge_ratio > 0 && on_depth_edge(depth_m, u, v, d, depth_edge_ratio)) ++f->depth_edge_rejected;
-        else f->depth[i] = d;
+        if (depth_edge_ratio > 0 && on_depth_edge(depth_m, u, v, d, depth_edge_ratio)) {
+          ++f->depth_edge_rejected;
+          f->on_depth_edge[i] = 1;
+        } else {
+          f->depth[i] = d;
+        }
       }
     }
   }

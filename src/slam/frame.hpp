@@ -2,6 +2,7 @@
 // A tracked image: its features (immutable once extracted, shared with the keyframe it may become) and the
 // per-frame tracking state (pose, matched map points, outlier flags).
 #include <Eigen/Geometry>
+#include <cstdint>
 #include <memory>
 #include <opencv2/core.hpp>
 #include <vector>
@@ -32,6 +33,7 @@ struct FrameFeatures {
   double close_depth = 3.0;  // metres: points closer than this are "close" (reliable depth)
   double disparity_weight = 0.0;  // the depth sensor's noise model for optimisation (optim::Observation)
   int depth_edge_rejected = 0;  // keypoints whose depth was dropped by the depth-edge test
+  std::vector<std::uint8_t> on_depth_edge;  // per keypoint: 1 where that test dropped its depth
 
   static constexpr int kGridCols = 64, kGridRows = 48;
   std::vector<std::vector<int>> grid;  // kGridCols * kGridRows cells of keypoint indices

@@ -127,6 +127,7 @@ void MapPoint::replace_with(const std::shared_ptr<MapPoint>& other) {
   }
   other->increase_found(found_.load());
   other->increase_visible(visible_.load());
+  other->flagged_.fetch_add(flagged_.load());
   other->compute_descriptor();
 }
 

@@ -73,6 +73,9 @@ class MapPoint {
   void increase_visible(int n = 1) { visible_.fetch_add(n); }
   void increase_found(int n = 1) { found_.fetch_add(n); }
   int found() const { return found_.load(); }
+  /// Frames whose pose optimisation matched the point and flagged it an outlier (what a viewer colours by).
+  void increase_flagged() { flagged_.fetch_add(1); }
+  int flagged() const { return flagged_.load(); }
   double found_ratio() const { return static_cast<double>(found_.load()) / std::max(1, visible_.load()); }
   /// A point tracking can lean on in frame `frame_id`: a real map point (not a temporary depth point), found as
   /// an inlier in at least `min_found` frames and created at least `min_age` frames before.
@@ -103,7 +106,7 @@ class MapPoint {
   std::shared_ptr<KeyFrame> reference_;
   std::shared_ptr<MapPoint> replaced_by_;
   double min_distance_ = 0, max_distance_ = 0;
-  std::atomic<int> visible_{1}, found_{1};
+  std::atomic<int> visible_{1}, found_{1}, flagged_{0};
   std::atomic<bool> bad_{false};
 };
 

@@ -79,6 +79,8 @@ TrackOutcome Tracker::track(const RgbdFrame& input) {
   TrackOutcome out;
   const auto t_start = Clock::now();
   Frame cur = build_frame(input, out.timings);
+  out.features = cur.features;
+  out.keypoint_fate.assign(cur.features->size(), KeypointFate::Unmatched);
   out.keypoints = static_cast<int>(cur.features->size());
   for (std::size_t i = 0; i < cur.features->size(); ++i) out.keypoints_with_depth += cur.features->has_depth(i);
   out.depth_edge_rejected = cur.features->depth_edge_rejected;
@@ -115,6 +117,7 @@ TrackOutcome Tracker::track(const RgbdFrame& input) {
     has_velocity_ = !std::exchange(awaiting_loaded_map_, false);
     velocity_ = has_velocity_ ? cur.T_cw * last_.T_cw.inverse() : Eigen::Isometry3d::Identity();
     clean_temporary_matches(cur);
+    record_fates(cur, out);
     for (std::size_t i = 0; i < cur.map_points.size(); ++i)
       if (cur.map_points[i] && cur.outlier[i]) cur.map_points[i].reset();
     out.inliers = cur.num_tracked();
@@ -156,6 +159,11 @@ TrackOutcome Tracker::track(const RgbdFrame& input) {
   last_is_keyframe_ = out.keyframe;
   out.timings.track_ms = ms_since(t_start);
   return out;
+}
+
+void Tracker::record_fates(const Frame& cur, TrackOutcome& out) {
+  for (std::size_t i = 0; i < cur.map_points.size(); ++i)
+    if (cur.map_points[i]) out.keypoint_fate[i] = cur.outlier[i] ? KeypointFate::Outlier : KeypointFate::Inlier;
 }
 
 void Tracker::start_in_loaded_map(long next_frame_id, int segments) {
@@ -435,7 +443,11 @@ bool Tracker::track_local_map(Frame& cur, FrameTimings& t) {
   int inliers = 0;
   for (std::size_t i = 0; i < cur.map_points.size(); ++i) {
     const MapPointPtr& mp = cur.map_points[i];
-    if (!mp || cur.outlier[i]) continue;
+    if (!mp) continue;
+    if (cur.outlier[i]) {
+      mp->increase_flagged();
+      continue;
+    }
     mp->increase_found();
     if (mp->num_observations() > 0) ++inliers;
   }

@@ -44,6 +44,9 @@ struct Relocalization {
   int place_score = 0;   // signature matches (of 256)
 };
 
+/// What tracking made of one keypoint of the frame.
+enum class KeypointFate : std::uint8_t { Unmatched = 0, Inlier = 1, Outlier = 2 };
+
 struct TrackOutcome {
   TrackState state = TrackState::NotInitialized;
   bool keyframe = false;
@@ -58,6 +61,10 @@ struct TrackOutcome {
   // the frame's pose in the final trajectory, not this); empty when the frame was not tracked.
   std::optional<Eigen::Isometry3d> live_T_wc;
   std::optional<Relocalization> relocalized;  // set on the frame global relocalization found
+  // The frame's keypoints (undistorted, after the person filter) and, per keypoint, what pose optimisation made of
+  // it: an outlier is a match the kernel gave a weight below its gate (chi-square test of the weighted residual).
+  std::shared_ptr<const FrameFeatures> features;
+  std::vector<KeypointFate> keypoint_fate;
 };
 
 /// Pose of a frame kept relative to its reference keyframe, so later keyframe corrections (BA) move it too.
@@ -99,6 +106,7 @@ class Tracker {
   Frame build_frame(const RgbdFrame& input, FrameTimings& t);
   bool initialize(Frame& cur, const Eigen::Isometry3d& T_cw);
   void refresh_last_frame();
+  static void record_fates(const Frame& cur, TrackOutcome& out);
   /// Motion model, falling back to (or cross-checked by) the reference keyframe; true when tracked.
   bool track_initial_pose(Frame& cur, FrameTimings& t);
   /// Both return the inliers after pose optimisation (0 when too few matches to optimise).

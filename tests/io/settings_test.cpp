@@ -1,6 +1,7 @@
 #include "io/settings.hpp"
 
 #include <gmock/gmock.h>
+#include <fstream>
 #include <gtest/gtest.h>
 
 #include "core/error.hpp"
@@ -292,6 +293,17 @@ TEST(Settings, TypedReadsFallBackToTheRegistryAndRejectWrongTypes) {
   // Reading a key the registry does not declare is a programming error, not a silent default.
   EXPECT_THROW(setting<int>(s, "tracking.nosuch"), std::logic_error);
   EXPECT_THROW(setting<int>(s, "tracking.kernel"), std::logic_error);  // declared as a choice
+}
+
+TEST(Settings, AKeyThatIsAMapOrAListIsRefusedByLine) {
+  // Found by fuzzing: YAML allows such a key, an ORB-SLAM file read fine, and its copy written back did not read.
+  TempDir dir;
+  const auto file = dir / "s.yaml";
+  std::ofstream(file) << "camera: {fx: 500, fy: 500, cx: 320, cy: 240}\nTbc:\n  rows: 4\n  {}: f\n";
+  EXPECT_THAT(config_error([&] { load_settings(file); }),
+              AllOf(HasSubstr(file.string() + ":4:"), HasSubstr("a key must be a name, not a map")));
+  std::ofstream(file) << "camera: {fx: 500, fy: 500, cx: 320, cy: 240}\n? [a, b]\n: 1\n";
+  EXPECT_THAT(config_error([&] { load_settings(file); }), HasSubstr("not a list"));
 }
 
 }  // namespace

@@ -1,0 +1,130 @@
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include "slam/e2e_support.hpp"
+#include "core/error.hpp"
+#include "viewer/live_viewer.hpp"
+// Last: glibc's resolv.h, which it includes, defines a macro `_res` that breaks Eigen's headers after it.
+#include <fmt/format.h>
+#include <httplib.h>
+
+namespace varslam::viewer {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+using ::testing::HasSubstr;
+
+fs::path walking_sequence() {
+  synth::SynthConfig cfg;
+  cfg.scenario = "walking";
+  cfg.seconds = 2.0;
+  cfg.seed = 5;
+  return slam::e2e::cached_sequence("pipeline_walking", cfg);  // pipeline/slam_test's
+}
+
+std::string file_text(const fs::path& f) {
+  std::ifstream in(f, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+run::RunSummary run_walking(const std::string& name, std::vector<Observer*> observers) {
+  run::RunOptions ro;
+  ro.progress = false;
+  ro.observers = std::move(observers);
+  const fs::path out = fs::temp_directory_path() / ("varslam_viewer_" + name + "_" + std::to_string(::getpid()));
+  return slam::e2e::run_with(walking_sequence(), out, ro, {"semantic.detector=boxes"});
+}
+
+/// A browser stand-in: reads /events on its own thread until told to stop.
+class EventReader {
+ public:
+  explicit EventReader(int port)
+      : thread_([this, port] {
+          httplib::Client c("127.0.0.1", port);
+          c.set_read_timeout(60, 0);
+          c.Get("/events", [this](const char* data, std::size_t n) {
+            std::lock_guard lock(mutex_);
+            text_.append(data, n);
+            return !stop_.load();
+          });
+        }) {}
+  ~EventReader() { finish(); }
+  void finish() {
+    stop_ = true;
+    if (thread_.joinable()) thread_.join();
+  }
+  std::string text() const {
+    std::lock_guard lock(mutex_);
+    return text_;
+  }
+  bool wait_for(const std::string& what, std::chrono::milliseconds limit) const {
+    const auto t0 = std::chrono::steady_clock::now();
+    while (std::chrono::steady_clock::now() - t0 < limit) {
+      if (text().find(what) != std::string::npos) return true;
+      std::this_thread::sleep_for(20ms);
+    }
+    return false;
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::string text_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+TEST(LiveViewer, TheTrajectoryIsByteIdenticalWithAndWithoutTheViewerAndABrowserConnected) {
+  const run::RunSummary plain = run_walking("plain", {});
+  LiveViewer viewer({});
+  EventReader browser(viewer.port());
+  ASSERT_TRUE(browser.wait_for("event: hello", 5s));
+  const run::RunSummary watched = run_walking("watched", {&viewer});
+  EXPECT_EQ(file_text(plain.out_dir / "CameraTrajectory.txt"), file_text(watched.out_dir / "CameraTrajectory.txt"));
+  EXPECT_EQ(file_text(plain.out_dir / "LiveTrajectory.txt"), file_text(watched.out_dir / "LiveTrajectory.txt"));
+  ASSERT_TRUE(browser.wait_for("event: done", 10s));
+  const std::string got = browser.text();
+  EXPECT_THAT(got, HasSubstr("event: frame"));
+  EXPECT_THAT(got, HasSubstr("event: map"));
+  EXPECT_THAT(got, HasSubstr("event: alpha"));
+  EXPECT_THAT(got, HasSubstr("\"final\":true"));
+  const LiveViewerStats s = viewer.stats();
+  EXPECT_EQ(s.frames_seen, watched.frames);
+  EXPECT_GT(s.frames_encoded, 0u);
+  EXPECT_LE(s.frames_encoded, s.frames_seen);
+  EXPECT_GE(s.maps_encoded, 1u);
+  browser.finish();
+}
+
+TEST(LiveViewer, WithoutABrowserNothingIsEncodedButTheFinalStateWaitsForOne) {
+  LiveViewer viewer({});
+  const run::RunSummary r = run_walking("absent", {&viewer});
+  const LiveViewerStats before = viewer.stats();
+  EXPECT_EQ(before.frames_seen, r.frames);
+  EXPECT_EQ(before.frames_encoded, 0u);  // no browser: no JPEG, no JSON
+  EXPECT_EQ(before.maps_encoded, 0u);    // the final map is encoded by on_finished, not the encoder
+  EventReader late(viewer.port());       // a browser that comes after the run
+  ASSERT_TRUE(late.wait_for("event: frame", 5s));
+  const std::string got = late.text();
+  EXPECT_EQ(got.find("event: hello"), 0u);
+  EXPECT_THAT(got, HasSubstr("\"final\":true"));
+  EXPECT_THAT(got, HasSubstr("event: done"));
+  EXPECT_THAT(got, HasSubstr(fmt::format("\"index\":{}", r.frames - 1)));  // the newest frame
+}
+
+TEST(LiveViewer, APortInUseFailsBeforeTheRun) {
+  LiveViewer first({});
+  LiveViewerOptions o;
+  o.server.port = first.port();
+  EXPECT_THROW(LiveViewer second(o), InputError);
+}
+
+}  // namespace
+}  // namespace varslam::viewer
