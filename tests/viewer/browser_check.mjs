@@ -35,7 +35,7 @@ try {
   }
   let framesBeforeEnd = 0;
   if (live) {
-    await page.waitForFunction(() => viewerStatus.done, { timeout: 120000, polling: 100 });
+    await page.waitForFunction(() => viewerStatus.done, { timeout: 600000, polling: 100 });
     framesBeforeEnd = await page.evaluate(() => viewerStatus.framesBeforeDone);
   }
   await new Promise((r) => setTimeout(r, 700));  // the last render and image decode

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# The viewer as a user sees it: `varslam run --viewer` on a short synthetic walking scene (real-time, paced, so the
-# browser joins while it runs) and `varslam view` on the finished run, each opened in headless chromium
+# The viewer as a user sees it: `varslam run --viewer` on a short synthetic walking scene (real-time, paced, started
+# once the browser is connected) and `varslam view` on the finished run, each opened in headless chromium
 # (browser_check.mjs checks the drawn page). Screenshots: <build>/viewer-screenshots/.
 # Usage: browser_test.sh SOURCE_DIR BUILD_DIR
 set -euo pipefail
@@ -42,10 +42,10 @@ url_of() {  # log file -> the URL the viewer printed
   fail "no viewer address in $1"
 }
 
-"$bin" synth --scenario walking --seconds 8 --seed 2 --out "$work/walk" --no-preview >/dev/null
+"$bin" synth --scenario walking --seconds 5 --seed 2 --out "$work/walk" --no-preview >/dev/null
 
 echo "[browser] live run"
-"$bin" run -d "$work/walk" -o "$work/run" --realtime --pace --viewer --viewer-hold -q \
+"$bin" run -d "$work/walk" -o "$work/run" --realtime --pace --viewer --viewer-wait --viewer-hold -q \
   --set semantic.detector=boxes >"$work/run.out" 2>"$work/run.err" &
 run_pid=$!
 pids+=("$run_pid")
