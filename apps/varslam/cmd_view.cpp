@@ -60,6 +60,7 @@ void add_view_command(CLI::App& app) {
     viewer::ViewerBoard board;
     board.set_greeting(run.greeting);
     board.set_map(run.map);
+    for (const std::string& e : run.log) board.append(e);
     viewer::FrameImageSource images;
     if (dataset) {
       const auto [first, count] = viewer::frames_of_run(*dataset, o->run);

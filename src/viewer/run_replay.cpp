@@ -52,6 +52,37 @@ void add_saved_map(MapView& v, const mapfile::SavedMap& m) {
     v.points.push_back({p.position.cast<float>(), static_cast<float>(p.first_keyframe_id), 0.0f});
 }
 
+/// The Local BA alphas and closed loops metrics.json recorded, as the live viewer logs them.
+std::vector<std::string> logged_events(const fs::path& metrics_file) {
+  std::vector<std::string> log;
+  if (!fs::exists(metrics_file)) return log;
+  std::ifstream in(metrics_file);
+  nlohmann::json m;
+  try {
+    m = nlohmann::json::parse(in);
+    for (const auto& ba : m.value("local_ba", nlohmann::json::array()))
+      log.push_back(sse_event("alpha", nlohmann::json{{"keyframe", ba.at("keyframe")},
+                                                      {"t", ba.at("timestamp")},
+                                                      {"alpha", ba.at("final_alpha")},
+                                                      {"fitted", ba.at("fitted_alpha")},
+                                                      {"refine", ba.at("refine_alpha")},
+                                                      {"observations", ba.at("observations")},
+                                                      {"outliers", ba.at("outliers")}}
+                                               .dump()));
+    for (const auto& l : m.value("loops", nlohmann::json::array()))
+      log.push_back(sse_event("loop", nlohmann::json{{"query", l.at("keyframe")},
+                                                     {"match", l.at("loop_keyframe")},
+                                                     {"t", l.at("timestamp")},
+                                                     {"inliers", l.at("inliers")},
+                                                     {"correction_m", l.at("correction_m")},
+                                                     {"correction_deg", l.at("correction_deg")}}
+                                              .dump()));
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(fmt::format("{}: not the metrics a run writes ({})", metrics_file.string(), e.what()));
+  }
+  return log;
+}
+
 const StampedPose* pose_at(const Trajectory& t, double stamp) {
   auto it = std::lower_bound(t.begin(), t.end(), stamp - kStampTolerance,
                              [](const StampedPose& p, double s) { return p.timestamp < s; });
@@ -153,6 +184,7 @@ FinishedRun load_finished_run(const fs::path& run_dir, const Dataset* dataset,
                                                    {"images", dataset != nullptr}}
                                         .dump());
   run.map = sse_event("map", map_message(v).dump());
+  run.log = logged_events(run_dir / "metrics.json");
   return run;
 }
 

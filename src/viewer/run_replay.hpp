@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "io/dataset.hpp"
 #include "viewer/viewer_board.hpp"
@@ -16,6 +17,7 @@ namespace varslam::viewer {
 struct FinishedRun {
   std::string greeting;  // "hello" event: frame stamps and poses for the slider
   std::string map;       // "map" event
+  std::vector<std::string> log;  // "alpha" and "loop" events from the run's metrics.json (when there)
   std::size_t frames = 0, map_points = 0, keyframes = 0;
 };
 
