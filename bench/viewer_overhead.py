@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
-"""What the live viewer costs tracking: real-time runs with and without `--viewer`, a headless chromium page
-connected to the viewer for the whole run (`--viewer-wait`), interleaved in one session so both see the same
-machine load. Prints a markdown table of the medians over the repeats (tracking median ms and frames per second
+"""What the live viewer costs tracking: real-time runs without the viewer, with `--viewer` and no browser, and with a
+headless chromium page connected for the whole run (`--viewer-wait`), interleaved in one session so all see the same
+machine load (the browser renders WebGL in software on the same cores). Prints a markdown table of the medians over the repeats (tracking median ms and frames per second
 from metrics.json, frames the page received) and the ratios.
   bench/viewer_overhead.py --binary build/bin/varslam --dataset DIR [--dataset DIR ...] [--repeats 3] [--work /tmp/vo]
 The page is opened by tests/viewer/browser_check.mjs's puppeteer-core (installed by tests/viewer/browser_test.sh in
@@ -22,8 +22,12 @@ await browser.close();
 """
 
 
-def run(binary, dataset, out, viewer, npm_dir, extra):
+def run(binary, dataset, out, mode, npm_dir, extra):
+    """mode: "plain", "viewer" (no browser) or "browser" (viewer and a connected page)."""
+    viewer = mode == "browser"
     cmd = [binary, "run", "-d", dataset, "-o", str(out), "--realtime", "-q"] + extra
+    if mode == "viewer":
+        cmd += ["--viewer"]
     if viewer:
         cmd += ["--viewer", "--viewer-wait", "--viewer-hold"]
     err = open(str(out) + ".err", "w")
@@ -48,7 +52,9 @@ def run(binary, dataset, out, viewer, npm_dir, extra):
         sys.exit(f"{cmd} exited {rc}: see {out}.err")
     m = json.loads((out / "metrics.json").read_text())
     received = json.loads(page.stdout.strip().splitlines()[-1])["frames"] if page else 0
-    return m["timings"]["tracking"]["median_ms"], m["fps"], received, m["frames"]
+    cost = re.search(r"([0-9.]+) ms per frame on the tracking thread", Path(str(out) + ".err").read_text())
+    return (m["timings"]["tracking"]["median_ms"], m["fps"], received, m["frames"],
+            float(cost.group(1)) if cost else 0.0)
 
 
 def main():
@@ -68,20 +74,23 @@ def main():
     work = Path(a.work)
     work.mkdir(parents=True, exist_ok=True)
     extra = sum((["--set", s] for s in a.set), [])
-    print("| dataset | frames | tracking median ms, no viewer | with viewer + browser | ratio | fps, no viewer | "
-          "with viewer + browser | ratio | frames the page got |")
+    print("| dataset | frames | configuration | tracking median ms | ratio | fps | ratio | viewer ms/frame on the "
+          "tracking thread | frames the page got |")
     print("|---|---|---|---|---|---|---|---|---|")
+    modes = ("plain", "viewer", "browser")
+    names = {"plain": "no viewer", "viewer": "--viewer, no browser", "browser": "--viewer, chromium connected"}
     for ds in a.dataset:
-        rows = {False: [], True: []}
+        rows = {m: [] for m in modes}
         for r in range(a.repeats):
-            for viewer in (False, True):  # interleaved: both see the same load
-                out = work / f"{Path(ds).name}_{'viewer' if viewer else 'plain'}_{r}"
-                rows[viewer].append(run(str(binary), ds, out, viewer, npm_dir, extra))
-                print(f"  {Path(ds).name} repeat {r} viewer={viewer}: {rows[viewer][-1]}", file=sys.stderr)
+            for mode in modes:  # interleaved: every configuration sees the same load
+                out = work / f"{Path(ds).name}_{mode}_{r}"
+                rows[mode].append(run(str(binary), ds, out, mode, npm_dir, extra))
+                print(f"  {Path(ds).name} repeat {r} {mode}: {rows[mode][-1]}", file=sys.stderr)
         med = lambda v, k: statistics.median(x[k] for x in rows[v])
-        t0, t1, f0, f1 = med(False, 0), med(True, 0), med(False, 1), med(True, 1)
-        print(f"| {Path(ds).name} | {rows[False][0][3]} | {t0:.2f} | {t1:.2f} | {t1 / t0:.3f} | {f0:.1f} | {f1:.1f} | "
-              f"{f1 / f0:.3f} | {int(med(True, 2))} |")
+        for mode in modes:
+            print(f"| {Path(ds).name} | {rows[mode][0][3]} | {names[mode]} | {med(mode, 0):.2f} | "
+                  f"{med(mode, 0) / med('plain', 0):.3f} | {med(mode, 1):.1f} | {med(mode, 1) / med('plain', 1):.3f} | "
+                  f"{med(mode, 4):.3f} | {int(med(mode, 2))} |")
 
 
 if __name__ == "__main__":

@@ -124,6 +124,13 @@ void add_run_command(CLI::App& app) {
       }
     }
     const run::RunSummary s = run::run_slam(*dataset, settings, ro, o->out);
+    if (live_viewer) {
+      const viewer::LiveViewerStats v = live_viewer->stats();
+      spdlog::info("viewer: {} frames sent of {} ({} maps); {:.3f} ms per frame on the tracking thread (max {:.2f})",
+                   v.frames_sent, v.frames_seen, v.maps_encoded,
+                   v.observer_ms_total / static_cast<double>(std::max<std::uint64_t>(1, v.frames_seen)),
+                   v.observer_ms_max);
+    }
     write_report_for_run(s.out_dir, o->dataset);
     print_run_summary(s);
     if (live_viewer && o->viewer_hold && !s.interrupted) {
