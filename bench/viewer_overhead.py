@@ -65,6 +65,7 @@ def main():
     ap.add_argument("--work", default="/tmp/varslam_viewer_overhead")
     ap.add_argument("--npm-dir", default=None, help="folder with puppeteer-core (default <build>/viewer-test-npm)")
     ap.add_argument("--set", action="append", default=[])
+    ap.add_argument("--viewer-fps", type=float, default=None, help="--viewer-fps for the viewer runs")
     a = ap.parse_args()
     binary = Path(a.binary).resolve()
     npm_dir = Path(a.npm_dir) if a.npm_dir else binary.parent.parent / "viewer-test-npm"
@@ -84,7 +85,8 @@ def main():
         for r in range(a.repeats):
             for mode in modes:  # interleaved: every configuration sees the same load
                 out = work / f"{Path(ds).name}_{mode}_{r}"
-                rows[mode].append(run(str(binary), ds, out, mode, npm_dir, extra))
+                vextra = extra + (["--viewer-fps", str(a.viewer_fps)] if a.viewer_fps and mode != "plain" else [])
+                rows[mode].append(run(str(binary), ds, out, mode, npm_dir, vextra))
                 print(f"  {Path(ds).name} repeat {r} {mode}: {rows[mode][-1]}", file=sys.stderr)
         med = lambda v, k: statistics.median(x[k] for x in rows[v])
         for mode in modes:

@@ -8,6 +8,7 @@ import { OrbitControls } from '/three/OrbitControls.js';
 const status = {
   connected: false, greeted: false, live: true, frames: 0, lastIndex: -1, state: '', maps: 0, points: 0,
   keyframes: 0, marks: 0, drawnMarks: 0, alphas: 0, events: 0, done: false, framesBeforeDone: 0, connections: 0,
+  renders: 0, softwareWebGL: false,
 };
 window.viewerStatus = status;
 
@@ -26,8 +27,18 @@ const i32 = (b64) => new Int32Array(bytes(b64).buffer);
 
 // ---------------------------------------------------------------- 3-D scene
 const sceneEl = document.getElementById('scene');
-const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
-renderer.setPixelRatio(window.devicePixelRatio);
+// Software WebGL (SwiftShader, llvmpipe: a headless or GPU-less browser) renders on the CPU the SLAM shares: no
+// multisampling and one pixel per CSS pixel there.
+function softwareWebGL() {
+  const gl = document.createElement('canvas').getContext('webgl');
+  const info = gl && gl.getExtension('WEBGL_debug_renderer_info');
+  const name = info ? String(gl.getParameter(info.UNMASKED_RENDERER_WEBGL)) : '';
+  return /swiftshader|llvmpipe|software/i.test(name);
+}
+const software = softwareWebGL();
+status.softwareWebGL = software;
+const renderer = new THREE.WebGLRenderer({ antialias: !software, preserveDrawingBuffer: true });
+renderer.setPixelRatio(software ? 1 : window.devicePixelRatio);
 renderer.setClearColor(0x15181c);
 sceneEl.prepend(renderer.domElement);
 const scene = new THREE.Scene();
@@ -214,6 +225,7 @@ function requestRender() {
   requestAnimationFrame(() => {
     renderQueued = false;
     renderer.render(scene, camera);
+    status.renders += 1;
   });
 }
 

@@ -30,6 +30,7 @@ std::unique_ptr<viewer::LiveViewer> start_viewer(const Opts& o, const Dataset& d
   viewer::LiveViewerOptions vo;
   vo.server.address = o.viewer_address;
   vo.server.port = o.viewer_port;
+  vo.max_frame_rate = o.viewer_fps;
   vo.title = dataset.root().filename().string();
   const auto gt = ro.groundtruth ? ro.groundtruth : dataset.groundtruth();
   if (gt && std::filesystem::exists(*gt)) {
@@ -56,6 +57,7 @@ void add_run_command(CLI::App& app) {
     bool viewer = false, viewer_hold = false, viewer_wait = false;
     std::string viewer_address = "127.0.0.1";
     int viewer_port = 0;
+    double viewer_fps = 15;
     std::size_t first = 0, max_frames = SIZE_MAX;
     double min_tracked_share = 0.5;
     std::vector<std::string> overrides;
@@ -86,6 +88,10 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("--viewer-address", o->viewer_address,
                   "Listen on this address instead of loopback (reachable from the network: use with care)")
       ->capture_default_str();
+  cmd->add_option("--viewer-fps", o->viewer_fps,
+                  "Frames per second sent to the browser at most (lower it when the browser shares a small machine)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.5, 60.0));
   cmd->add_flag("--viewer-hold", o->viewer_hold, "Keep the viewer up after the run until Ctrl+C");
   cmd->add_flag("--viewer-wait", o->viewer_wait, "Start the run only once a browser is connected");
   cmd->add_option("--set", o->overrides, "Override a setting: section.key=value (repeatable)");

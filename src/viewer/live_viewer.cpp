@@ -232,7 +232,9 @@ void LiveViewer::encoder_loop() {
     std::vector<std::string> logged;
     {
       std::unique_lock lock(mutex_);
-      wake_.wait_for(lock, std::chrono::milliseconds(50), [&] { return stopping_ || !log_.empty() || map_ || frame_; });
+      // Without a browser a pending frame is no work: wake for it only once one is connected (checked every 50 ms).
+      wake_.wait_for(lock, std::chrono::milliseconds(50),
+                     [&] { return stopping_ || !log_.empty() || map_ || (frame_ && board_.clients() > 0); });
       if (stopping_) return;
       logged.swap(log_);
       // Frames wait for a browser (the newest one is kept) and for their slot in the rate.
