@@ -126,7 +126,8 @@ void add_run_command(CLI::App& app) {
       ro.observers.push_back(live_viewer.get());
       if (o->viewer_wait) {
         spdlog::info("viewer: waiting for a browser at {}", live_viewer->url());
-        while (live_viewer->clients() == 0 && !ro.stop->load()) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        while (live_viewer->clients() == 0 && !ro.stop->load())
+          std::this_thread::sleep_for(std::chrono::milliseconds(50));
       }
     }
     const run::RunSummary s = run::run_slam(*dataset, settings, ro, o->out);

@@ -99,8 +99,8 @@ void LiveViewer::on_detection(const DetectionEvent& e) {
   v.box_age_s = e.box_age_s;
   v.people.clear();
   for (std::size_t i = 0; i < e.people.rects.size(); ++i)
-    v.people.push_back({e.people.rects[i], i < e.people.persons.size() ? e.people.persons[i].whole_m : 0.0f,
-                        e.depth_band_m});
+    v.people.push_back(
+        {e.people.rects[i], i < e.people.persons.size() ? e.people.persons[i].whole_m : 0.0f, e.depth_band_m});
   building_.person_dropped.clear();
   for (std::size_t i = 0; i < e.keypoints.size() && i < e.keep.size(); ++i)
     if (!e.keep[i]) building_.person_dropped.push_back(e.keypoints[i].pt);
@@ -240,8 +240,7 @@ void LiveViewer::encoder_loop() {
       // Frames wait for a browser (the newest one is kept) and for their slot in the rate.
       if (frame_ && board_.clients() > 0 && seconds_since(last_frame) >= 1.0 / options_.max_frame_rate)
         frame = std::exchange(frame_, std::nullopt);
-      if (map_ && seconds_since(last_map) >= 1.0 / options_.map_rate)
-        map = std::exchange(map_, std::nullopt);
+      if (map_ && seconds_since(last_map) >= 1.0 / options_.map_rate) map = std::exchange(map_, std::nullopt);
     }
     for (std::string& e : logged) board_.append(std::move(e));
     if (map) {
@@ -268,8 +267,10 @@ std::string LiveViewer::encode_frame(PendingFrame& f) const {
     f.view.marks.reserve(px.size() + f.person_dropped.size());
     for (std::size_t i = 0; i < px.size(); ++i) {
       std::uint8_t mark = static_cast<std::uint8_t>(KeypointMark::Unmatched);
-      if (i < f.fate.size() && f.fate[i] == slam::KeypointFate::Inlier) mark = static_cast<std::uint8_t>(KeypointMark::Inlier);
-      if (i < f.fate.size() && f.fate[i] == slam::KeypointFate::Outlier) mark = static_cast<std::uint8_t>(KeypointMark::Outlier);
+      if (i < f.fate.size() && f.fate[i] == slam::KeypointFate::Inlier)
+        mark = static_cast<std::uint8_t>(KeypointMark::Inlier);
+      if (i < f.fate.size() && f.fate[i] == slam::KeypointFate::Outlier)
+        mark = static_cast<std::uint8_t>(KeypointMark::Outlier);
       if (i < f.features->on_depth_edge.size() && f.features->on_depth_edge[i]) mark |= kDepthEdgeBit;
       f.view.marks.push_back({px[i].x, px[i].y, mark});
     }
@@ -299,7 +300,8 @@ std::string LiveViewer::encode_map(const PendingMap& m) const {
   }
   v.live = positions(m.live);
   v.final_trajectory = positions(m.final_trajectory);
-  if (options_.groundtruth) v.groundtruth = groundtruth_in_map_frame(*options_.groundtruth, m.final ? m.final_trajectory : m.live);
+  if (options_.groundtruth)
+    v.groundtruth = groundtruth_in_map_frame(*options_.groundtruth, m.final ? m.final_trajectory : m.live);
   return sse_event("map", map_message(v).dump());
 }
 

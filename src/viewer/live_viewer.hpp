@@ -30,10 +30,10 @@ namespace varslam::viewer {
 
 struct LiveViewerOptions {
   ServerOptions server;
-  double max_frame_rate = 15;  // frame messages per second at most
-  double map_rate = 2;         // map messages per second at most
-  std::string title;           // what the page shows as the run's name (the dataset)
-  std::optional<Trajectory> groundtruth;  // drawn in the map's frame once the live trajectory aligns to it
+  double max_frame_rate = 15;                   // frame messages per second at most
+  double map_rate = 2;                          // map messages per second at most
+  std::string title;                            // what the page shows as the run's name (the dataset)
+  std::optional<Trajectory> groundtruth;        // drawn in the map's frame once the live trajectory aligns to it
   std::optional<std::filesystem::path> assets;  // the page's folder (else searched, viewer_assets.hpp)
 };
 

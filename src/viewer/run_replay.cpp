@@ -68,7 +68,7 @@ std::vector<std::string> logged_events(const fs::path& metrics_file) {
                                                       {"refine", ba.at("refine_alpha")},
                                                       {"observations", ba.at("observations")},
                                                       {"outliers", ba.at("outliers")}}
-                                               .dump()));
+                                           .dump()));
     for (const auto& l : m.value("loops", nlohmann::json::array()))
       log.push_back(sse_event("loop", nlohmann::json{{"query", l.at("keyframe")},
                                                      {"match", l.at("loop_keyframe")},
@@ -76,7 +76,7 @@ std::vector<std::string> logged_events(const fs::path& metrics_file) {
                                                      {"inliers", l.at("inliers")},
                                                      {"correction_m", l.at("correction_m")},
                                                      {"correction_deg", l.at("correction_deg")}}
-                                              .dump()));
+                                          .dump()));
   } catch (const nlohmann::json::exception& e) {
     throw InputError(fmt::format("{}: not the metrics a run writes ({})", metrics_file.string(), e.what()));
   }
@@ -123,8 +123,8 @@ FinishedRun load_finished_run(const fs::path& run_dir, const Dataset* dataset,
                               const std::optional<fs::path>& map_file) {
   const fs::path traj_file = run_dir / "CameraTrajectory.txt";
   if (!fs::exists(traj_file))
-    throw InputError(fmt::format("{}: not a run folder (no CameraTrajectory.txt; varslam run -o writes one)",
-                                 run_dir.string()));
+    throw InputError(
+        fmt::format("{}: not a run folder (no CameraTrajectory.txt; varslam run -o writes one)", run_dir.string()));
   const Trajectory final_traj = read_tum_trajectory(traj_file);
   const Trajectory live = read_if_present(run_dir / "LiveTrajectory.txt");
 
@@ -137,7 +137,8 @@ FinishedRun load_finished_run(const fs::path& run_dir, const Dataset* dataset,
   } else {
     v.points = read_ply_points(run_dir / "map.ply");
     long id = 0;
-    for (const StampedPose& k : read_if_present(run_dir / "KeyFrameTrajectory.txt")) v.keyframes.push_back({id++, k.T_wc});
+    for (const StampedPose& k : read_if_present(run_dir / "KeyFrameTrajectory.txt"))
+      v.keyframes.push_back({id++, k.T_wc});
   }
   if (dataset && dataset->groundtruth() && fs::exists(*dataset->groundtruth()))
     v.groundtruth = groundtruth_in_map_frame(read_tum_trajectory(*dataset->groundtruth()), final_traj);

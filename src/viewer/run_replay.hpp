@@ -15,8 +15,8 @@
 namespace varslam::viewer {
 
 struct FinishedRun {
-  std::string greeting;  // "hello" event: frame stamps and poses for the slider
-  std::string map;       // "map" event
+  std::string greeting;          // "hello" event: frame stamps and poses for the slider
+  std::string map;               // "map" event
   std::vector<std::string> log;  // "alpha" and "loop" events from the run's metrics.json (when there)
   std::size_t frames = 0, map_points = 0, keyframes = 0;
 };

@@ -70,10 +70,11 @@ std::vector<Asset> load_assets_from(const std::vector<fs::path>& search) {
   if (!found) {
     std::string where;
     for (const fs::path& d : search) where += (where.empty() ? "" : ", ") + d.lexically_normal().string();
-    throw InputError(fmt::format("the viewer's page and scripts (index.html, viewer.js, three/three.module.js, ...) "
-                                 "are not in {}; build with the viewer (npm installs three.js) or set "
-                                 "VARSLAM_VIEWER_DIR",
-                                 where.empty() ? "any folder searched" : where));
+    throw InputError(
+        fmt::format("the viewer's page and scripts (index.html, viewer.js, three/three.module.js, ...) "
+                    "are not in {}; build with the viewer (npm installs three.js) or set "
+                    "VARSLAM_VIEWER_DIR",
+                    where.empty() ? "any folder searched" : where));
   }
   std::vector<Asset> assets;
   for (const AssetFile& a : kAssets) {

@@ -64,9 +64,12 @@ std::string base64(const void* data, std::size_t bytes) {
 
 std::string state_name(slam::TrackState s) {
   switch (s) {
-    case slam::TrackState::NotInitialized: return "initializing";
-    case slam::TrackState::Ok: return "tracking";
-    case slam::TrackState::Lost: return "lost";
+    case slam::TrackState::NotInitialized:
+      return "initializing";
+    case slam::TrackState::Ok:
+      return "tracking";
+    case slam::TrackState::Lost:
+      return "lost";
   }
   return "unknown";
 }
@@ -82,8 +85,10 @@ nlohmann::json frame_message(const FrameView& f, const cv::Mat& image, int max_w
   j["inliers"] = f.inliers;
   j["depth_edge_rejected"] = f.depth_edge_rejected;
   j["fps"] = f.fps;
-  j["timings"] = {{"extract_ms", f.timings.extract_ms}, {"filter_ms", f.timings.filter_ms},
-                  {"match_ms", f.timings.match_ms},     {"pose_ms", f.timings.pose_ms},
+  j["timings"] = {{"extract_ms", f.timings.extract_ms},
+                  {"filter_ms", f.timings.filter_ms},
+                  {"match_ms", f.timings.match_ms},
+                  {"pose_ms", f.timings.pose_ms},
                   {"track_ms", f.timings.track_ms}};
   j["map_keyframes"] = f.map_keyframes;
   j["map_points"] = f.map_points;

@@ -5,11 +5,10 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "core/trajectory.hpp"
 #include "slam/tracking.hpp"
@@ -31,8 +30,8 @@ struct MarkedKeypoint {
 };
 
 struct PersonBand {
-  cv::Rect box;         // as the filter used it (enlarged, clipped)
-  float depth_m = 0;    // the person's depth, 0 = unknown
+  cv::Rect box;       // as the filter used it (enlarged, clipped)
+  float depth_m = 0;  // the person's depth, 0 = unknown
   float band_m = 0;
 };
 
@@ -66,9 +65,9 @@ struct PointView {
 struct MapView {
   std::vector<KeyframeView> keyframes;
   std::vector<PointView> points;
-  std::vector<std::pair<long, long>> covisibility, spanning_tree;  // keyframe id pairs
+  std::vector<std::pair<long, long>> covisibility, spanning_tree;    // keyframe id pairs
   std::vector<Eigen::Vector3d> live, final_trajectory, groundtruth;  // groundtruth in the map's frame
-  bool final = false;  // after finish(): the final trajectory and map
+  bool final = false;                                                // after finish(): the final trajectory and map
 };
 
 std::string base64(const void* data, std::size_t bytes);

@@ -38,8 +38,9 @@ ViewerServer::ViewerServer(ViewerBoard& board, std::vector<Asset> assets, const 
   if (port_ <= 0)
     throw InputError(fmt::format("viewer: cannot listen on {}:{} ({}; --viewer-port 0 picks a free port)",
                                  options_.address, options_.port,
-                                 options_.port == 0 ? "no free port" : "the port is taken or the address is not this "
-                                                                       "machine's"));
+                                 options_.port == 0 ? "no free port"
+                                                    : "the port is taken or the address is not this "
+                                                      "machine's"));
   thread_ = std::thread([this] {
     server_->listen_after_bind();
     listen_returned_ = true;

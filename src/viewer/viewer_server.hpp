@@ -21,8 +21,8 @@ namespace varslam::viewer {
 
 struct ServerOptions {
   std::string address = "127.0.0.1";
-  int port = 0;          // 0: a free port
-  int max_clients = 8;   // live streams at once; one more is answered 503
+  int port = 0;         // 0: a free port
+  int max_clients = 8;  // live streams at once; one more is answered 503
 };
 
 /// JPEG of frame i, or empty when there is no such frame.

@@ -1,3 +1,5 @@
+#include "viewer/live_viewer.hpp"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -6,9 +8,8 @@
 #include <sstream>
 #include <thread>
 
-#include "slam/e2e_support.hpp"
 #include "core/error.hpp"
-#include "viewer/live_viewer.hpp"
+#include "slam/e2e_support.hpp"
 // Last: glibc's resolv.h, which it includes, defines a macro `_res` that breaks Eigen's headers after it.
 #include <fmt/format.h>
 #include <httplib.h>

@@ -1,9 +1,10 @@
+#include "viewer/run_replay.hpp"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "core/error.hpp"
 #include "slam/e2e_support.hpp"
-#include "viewer/run_replay.hpp"
 
 namespace varslam::viewer {
 namespace {

@@ -1,8 +1,8 @@
+#include "viewer/viewer_board.hpp"
+
 #include <gtest/gtest.h>
 
 #include <thread>
-
-#include "viewer/viewer_board.hpp"
 
 namespace varslam::viewer {
 namespace {

@@ -1,10 +1,10 @@
+#include "viewer/viewer_messages.hpp"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cstring>
 #include <opencv2/imgcodecs.hpp>
-
-#include "viewer/viewer_messages.hpp"
 
 namespace varslam::viewer {
 namespace {

@@ -1,3 +1,5 @@
+#include "viewer/viewer_server.hpp"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <httplib.h>
@@ -6,7 +8,6 @@
 #include <thread>
 
 #include "core/error.hpp"
-#include "viewer/viewer_server.hpp"
 
 namespace varslam::viewer {
 namespace {
@@ -99,7 +100,8 @@ TEST(ViewerServer, StopEndsOpenStreams) {
   const int port = server->port();
   std::atomic<bool> ended{false};
   std::thread client([&] {
-    read_events(port, [](const std::string&) { return false; }, 20000ms);
+    read_events(
+        port, [](const std::string&) { return false; }, 20000ms);
     ended = true;
   });
   const auto t0 = std::chrono::steady_clock::now();
@@ -115,7 +117,10 @@ TEST(ViewerServer, MoreStreamsThanAllowedAreAnswered503) {
   ViewerBoard board;
   board.set_greeting(sse_event("hello", "{}"));
   ViewerServer server(board, fake_assets(), {"127.0.0.1", 0, 1});
-  std::thread first([&] { read_events(server.port(), [](const std::string&) { return false; }, 1500ms); });
+  std::thread first([&] {
+    read_events(
+        server.port(), [](const std::string&) { return false; }, 1500ms);
+  });
   const auto t0 = std::chrono::steady_clock::now();
   while (board.clients() == 0 && std::chrono::steady_clock::now() - t0 < 5s) std::this_thread::sleep_for(10ms);
   httplib::Client c("127.0.0.1", server.port());
