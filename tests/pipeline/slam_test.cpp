@@ -21,13 +21,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path walking_sequence() {
-  synth::SynthConfig cfg;
-  cfg.scenario = "walking";
-  cfg.seconds = 2.0;
-  cfg.seed = 5;
-  return slam::e2e::cached_sequence("pipeline_walking", cfg);
-}
+fs::path walking_sequence() { return slam::e2e::pipeline_walking_sequence(); }
 
 fs::path out_dir(const std::string& name) {
   const fs::path d = fs::temp_directory_path() / ("varslam_pipeline_" + name + "_" + std::to_string(::getpid()));

@@ -31,6 +31,15 @@ inline fs::path cached_sequence(const std::string& name, synth::SynthConfig cfg)
   return d;
 }
 
+/// The 2-s walking scene (seed 5) the pipeline and viewer tests share.
+inline fs::path pipeline_walking_sequence() {
+  synth::SynthConfig cfg;
+  cfg.scenario = "walking";
+  cfg.seconds = 2.0;
+  cfg.seed = 5;
+  return cached_sequence("pipeline_walking", cfg);
+}
+
 /// Runs SLAM with the dataset's settings (plus `overrides`, as --set takes them) and these options into `out`.
 inline run::RunSummary run_with(const fs::path& data, const fs::path& out, const run::RunOptions& options,
                                 const std::vector<std::string>& overrides = {}) {

@@ -21,13 +21,7 @@ namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 using ::testing::HasSubstr;
 
-fs::path walking_sequence() {
-  synth::SynthConfig cfg;
-  cfg.scenario = "walking";
-  cfg.seconds = 2.0;
-  cfg.seed = 5;
-  return slam::e2e::cached_sequence("pipeline_walking", cfg);  // pipeline/slam_test's
-}
+fs::path walking_sequence() { return slam::e2e::pipeline_walking_sequence(); }
 
 std::string file_text(const fs::path& f) {
   std::ifstream in(f, std::ios::binary);

@@ -12,13 +12,7 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
-fs::path walking_sequence() {
-  synth::SynthConfig cfg;
-  cfg.scenario = "walking";
-  cfg.seconds = 2.0;
-  cfg.seed = 5;
-  return slam::e2e::cached_sequence("pipeline_walking", cfg);  // pipeline/slam_test's
-}
+fs::path walking_sequence() { return slam::e2e::pipeline_walking_sequence(); }
 
 TEST(RunReplay, AFinishedRunShowsItsFramesMapAlphasAndSavedGraph) {
   run::RunOptions ro;
