@@ -11,9 +11,6 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-// Covisibility edges drawn: keyframes sharing at least this many points (the strong links, as ORB-SLAM's viewer).
-constexpr int kDrawnCovisibility = 100;
-
 /// Undistorted keypoint positions back to the pixels of the image shown.
 std::vector<cv::Point2f> image_pixels(const slam::FrameFeatures& f) {
   std::vector<cv::Point2f> px(f.size());

@@ -45,7 +45,7 @@ void add_saved_map(MapView& v, const mapfile::SavedMap& m) {
   for (const mapfile::SavedKeyframe& k : m.keyframes) {
     v.keyframes.push_back({k.id, k.T_cw.inverse()});
     for (const auto& [other, weight] : k.connections)
-      if (weight >= 100 && other > k.id) v.covisibility.emplace_back(k.id, other);
+      if (weight >= kDrawnCovisibility && other > k.id) v.covisibility.emplace_back(k.id, other);
     if (k.parent >= 0) v.spanning_tree.emplace_back(k.id, k.parent);
   }
   for (const mapfile::SavedMapPoint& p : m.map_points)

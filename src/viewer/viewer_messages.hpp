@@ -51,6 +51,9 @@ struct FrameView {
   std::vector<PersonBand> people;
 };
 
+// Covisibility edges drawn: keyframes sharing at least this many points (the strong links, as ORB-SLAM's viewer).
+constexpr int kDrawnCovisibility = 100;
+
 struct KeyframeView {
   long id = 0;
   Eigen::Isometry3d T_wc = Eigen::Isometry3d::Identity();
