@@ -64,6 +64,9 @@ void print_run_summary(const run::RunSummary& s) {
     fmt::print("ATE              {}\n", s.ate_note);
   else
     fmt::print("ATE              (no ground truth)\n");
+  if (s.ate_live_rmse)
+    fmt::print("live ATE         rmse {:.2f} cm, max {:.2f} cm, dragged {} time(s) (> 10 cm off within 1 s)\n",
+               *s.ate_live_rmse * 100.0, *s.ate_live_max * 100.0, s.dragged_events);
   if (s.ate_map_frame_rmse)
     fmt::print("ATE in map frame rmse {:.2f} cm, max {:.2f} cm (the loaded map's alignment to ground truth)\n",
                *s.ate_map_frame_rmse * 100.0, *s.ate_map_frame_max * 100.0);

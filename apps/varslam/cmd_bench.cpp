@@ -33,7 +33,7 @@ fs::path default_trajectories_dir() {
 void add_bench_command(CLI::App& app) {
   struct Opts {
     report::BenchOptions b;
-    std::string scenarios, paths, seeds, configs, trajectories;
+    std::string scenarios, paths, seeds, configs, trajectories, matrix = "default";
     std::vector<std::string> real;
     bool fresh = false;
   };
@@ -47,6 +47,10 @@ void add_bench_command(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "bench", "Benchmark matrix: scenarios x camera paths x seeds x configurations (and real folders), run as "
                "parallel child processes; writes results.json, table.md, index.html and a report.html per run");
+  std::string matrix_help = "Named matrix whose scenarios, paths, seeds, seconds and configurations are used "
+                            "where those options are not given:";
+  for (const auto& m : report::named_matrices()) matrix_help += fmt::format(" {} ({});", m.name, m.description);
+  cmd->add_option("--matrix", o->matrix, matrix_help)->capture_default_str();
   cmd->add_option("--scenarios", o->scenarios, "Synthetic scenarios, comma separated (empty: none)")->capture_default_str();
   cmd->add_option("--paths", o->paths,
                   "Camera paths, comma separated: folder names under --trajectories, folders or TUM files; "
@@ -81,7 +85,14 @@ void add_bench_command(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--trajectories", o->trajectories, "Folder of camera paths (default: ../shared/trajectories)");
 
-  cmd->callback([o] {
+  cmd->callback([o, cmd] {
+    // A named matrix fills what the command line leaves out.
+    const report::NamedMatrix& matrix = report::matrix_by_name(o->matrix);
+    if (cmd->count("--scenarios") == 0) o->scenarios = fmt::format("{}", fmt::join(matrix.scenarios, ","));
+    if (cmd->count("--paths") == 0) o->paths = fmt::format("{}", fmt::join(matrix.paths, ","));
+    if (cmd->count("--seeds") == 0) o->seeds = fmt::format("{}", fmt::join(matrix.seeds, ","));
+    if (cmd->count("--configs") == 0) o->configs = fmt::format("{}", fmt::join(matrix.configs, ","));
+    if (cmd->count("--seconds") == 0) o->b.seconds = matrix.seconds;
     report::BenchOptions b = o->b;
     b.scenarios = report::split_list(o->scenarios);
     b.paths = report::split_list(o->paths);
@@ -100,7 +111,7 @@ void add_bench_command(CLI::App& app) {
     b.reuse_sequences = !o->fresh;
     b.trajectories_dir = o->trajectories.empty() ? default_trajectories_dir() : fs::path(o->trajectories);
     // The exact command that reproduces this benchmark (every option spelled out).
-    std::vector<std::string> argv{"varslam", "bench", "--scenarios", o->scenarios, "--paths", o->paths, "--seeds",
+    std::vector<std::string> argv{"varslam", "bench", "--matrix", o->matrix, "--scenarios", o->scenarios, "--paths", o->paths, "--seeds",
                                   o->seeds, "--seconds", fmt::format("{}", b.seconds), "--configs", o->configs,
                                   "--detector", b.detector, "--out", b.out.string()};
     if (b.jobs) argv.insert(argv.end(), {"--jobs", std::to_string(b.jobs)});

@@ -20,7 +20,7 @@ void add_synth_command(CLI::App& app) {
     bool hide_movers = false;
   };
   auto opt = std::make_shared<Options>();
-  cmd->add_option("--scenario", opt->cfg.scenario, "static | walking | unknown_box | obstructing_box | balloon | mixed")
+  cmd->add_option("--scenario", opt->cfg.scenario, "static | walking | unknown_box | obstructing_box | balloon | mixed | large_box | large_box_people")
       ->capture_default_str();
   cmd->add_option("--seconds", opt->cfg.seconds, "Sequence length in seconds")->capture_default_str();
   cmd->add_option("--seed", opt->cfg.seed, "Random seed (same seed = identical files)")->capture_default_str();

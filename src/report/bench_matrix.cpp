@@ -1,6 +1,7 @@
 #include "report/bench_matrix.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <cmath>
@@ -8,6 +9,7 @@
 
 #include "core/error.hpp"
 #include "io/trajectory_io.hpp"
+#include "report/bench_runner.hpp"
 #include "synth/synth.hpp"
 
 namespace varslam::report {
@@ -48,6 +50,33 @@ std::vector<std::string> configuration_overrides(const BenchConfiguration& confi
     throw InputError("bench: detector must be boxes or yolo, got '" + detector + "'");
   }
   return o;
+}
+
+const std::vector<NamedMatrix>& named_matrices() {
+  static const std::vector<NamedMatrix> matrices = [] {
+    const BenchOptions defaults;
+    NamedMatrix quick{"default", "every scenario, 3-s sequences, 2 seeds", defaults.scenarios, defaults.paths,
+                      defaults.configs, defaults.seeds, defaults.seconds};
+    NamedMatrix large{"large_movers",
+                      "a large box carried 0.6-1.5 m in front of the camera, alone and with two people, 20-s "
+                      "sequences, 5 seeds",
+                      {"large_box", "large_box_people"},
+                      defaults.paths,
+                      {"huber", "full"},
+                      {1, 2, 3, 4, 5},
+                      20.0};
+    return std::vector<NamedMatrix>{quick, large};
+  }();
+  return matrices;
+}
+
+const NamedMatrix& matrix_by_name(const std::string& name) {
+  std::vector<std::string> names;
+  for (const auto& m : named_matrices()) {
+    if (m.name == name) return m;
+    names.push_back(m.name);
+  }
+  throw InputError(fmt::format("bench: unknown matrix '{}' (known: {})", name, fmt::join(names, ", ")));
 }
 
 std::string short_path_name(const std::string& folder_name) {

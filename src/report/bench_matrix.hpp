@@ -27,6 +27,20 @@ const BenchConfiguration& configuration_by_name(const std::string& name);
 std::vector<std::string> configuration_overrides(const BenchConfiguration& config, const std::string& detector,
                                                  const std::filesystem::path& boxes_file);
 
+/// A named benchmark matrix: what `varslam bench --matrix NAME` runs unless an option says otherwise.
+struct NamedMatrix {
+  std::string name;
+  std::string description;
+  std::vector<std::string> scenarios, paths, configs;
+  std::vector<std::uint64_t> seeds;
+  double seconds = 3.0;
+};
+/// "default" (every scenario, 3-s sequences, 2 seeds: the quick check) and "large_movers" (large boxes close to
+/// the camera, alone and with people, 20-s sequences, 5 seeds).
+const std::vector<NamedMatrix>& named_matrices();
+/// Throws InputError listing the known names when `name` is not one.
+const NamedMatrix& matrix_by_name(const std::string& name);
+
 /// A camera path for synthetic sequences: a groundtruth file and the window of it a sequence uses.
 struct CameraPathChoice {
   std::string name;                // short name for tables ("fr2_desk_with_person")

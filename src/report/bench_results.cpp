@@ -73,6 +73,10 @@ RunFigures figures_from_metrics(const nlohmann::json& m) {
   f.fps = json_number(m, {"fps"});
   f.tracking_median_ms = json_number(m, {"timings", "tracking", "median_ms"});
   f.wall_seconds = json_number(m, {"wall_seconds"});
+  f.ate_live_rmse_m = json_number(m, {"ate_live", "rmse"});
+  f.ate_live_max_m = json_number(m, {"ate_live", "max"});
+  f.dragged_events = json_number(m, {"ate_live", "dragged_events"});
+  f.local_ba_median_ms = json_number(m, {"timings", "local_ba", "median_ms"});
   return f;
 }
 
@@ -175,6 +179,100 @@ std::string render_static_ratio_table(const std::vector<RunRecord>& records, con
   return t.str();
 }
 
+namespace {
+
+// One configuration's runs of one table row, for the live table.
+struct LiveCell {
+  std::size_t runs = 0, final_n = 0, live_n = 0, drag_n = 0;
+  double final_sum = 0, final_worst = 0, live_sum = 0, live_worst = 0, drags = 0;
+  std::vector<double> tracking_ms, local_ba_ms;
+
+  void add(const RunRecord& r) {
+    ++runs;
+    if (!r.ok) return;
+    const RunFigures& f = r.figures;
+    if (std::isfinite(f.ate_rmse_m)) {
+      ++final_n;
+      final_sum += f.ate_rmse_m;
+      final_worst = std::max(final_worst, f.ate_rmse_m);
+    }
+    if (std::isfinite(f.ate_live_rmse_m)) {
+      ++live_n;
+      live_sum += f.ate_live_rmse_m;
+      live_worst = std::max(live_worst, f.ate_live_rmse_m);
+    }
+    if (std::isfinite(f.dragged_events)) {
+      ++drag_n;
+      drags += f.dragged_events;
+    }
+    if (std::isfinite(f.tracking_median_ms)) tracking_ms.push_back(f.tracking_median_ms);
+    if (std::isfinite(f.local_ba_median_ms)) local_ba_ms.push_back(f.local_ba_median_ms);
+  }
+};
+
+double median_of(std::vector<double> v) {
+  if (v.empty()) return kNaN;
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+std::string live_row(const LiveCell& c) {
+  auto mean = [](double sum, std::size_t n) { return n ? sum / static_cast<double>(n) : kNaN; };
+  // A peer writes no live trajectory and no timings: "-", not "fail".
+  const bool no_live = c.live_n == 0 && c.final_n > 0;
+  auto median_cell = [&](const std::vector<double>& v, int decimals) {
+    return v.empty() && c.final_n > 0 ? std::string("-") : cell(median_of(v), 1, decimals, v.size(), c.runs);
+  };
+  return cell(mean(c.final_sum, c.final_n), 100, 2, c.final_n, c.runs) + " | " +
+         cell(c.final_worst, 100, 2, c.final_n, c.runs) + " | " +
+         (no_live ? "-" : cell(mean(c.live_sum, c.live_n), 100, 2, c.live_n, c.runs)) + " | " +
+         (no_live ? "-" : cell(c.live_worst, 100, 2, c.live_n, c.runs)) + " | " + cell(c.drags, 1, 0, c.drag_n, c.runs) + " | " +
+         median_cell(c.tracking_ms, 1) + " | " + median_cell(c.local_ba_ms, 0);
+}
+
+}  // namespace
+
+std::string render_live_table(const std::vector<RunRecord>& records, const std::vector<std::string>& configs) {
+  if (std::none_of(records.begin(), records.end(),
+                   [](const RunRecord& r) { return std::isfinite(r.figures.ate_live_rmse_m); }))
+    return "";
+  // Rows: each scenario's paths in order of appearance, then the scenario over all paths.
+  std::vector<std::string> scenarios, paths;
+  for (const auto& r : records) {
+    if (r.scenario == "real") continue;
+    if (std::find(scenarios.begin(), scenarios.end(), r.scenario) == scenarios.end()) scenarios.push_back(r.scenario);
+    if (std::find(paths.begin(), paths.end(), r.path_name) == paths.end()) paths.push_back(r.path_name);
+  }
+  paths.push_back("all");
+  std::ostringstream t;
+  t << "| scenario | path |";
+  for (const auto& c : configs)
+    t << ' ' << c << " final mean | " << c << " final worst | " << c << " live mean | " << c << " live worst | " << c
+      << " dragged | " << c << " trk ms | " << c << " LBA ms |";
+  t << "\n|---|---|";
+  for (std::size_t i = 0; i < configs.size(); ++i) t << "--:|--:|--:|--:|--:|--:|--:|";
+  t << '\n';
+  for (const auto& sc : scenarios)
+    for (const auto& path : paths) {
+      const bool all = path == "all";
+      std::vector<LiveCell> cells(configs.size());
+      std::size_t n = 0;
+      for (const auto& r : records) {
+        if (r.scenario != sc || (!all && r.path_name != path)) continue;
+        const auto c = std::find(configs.begin(), configs.end(), r.config);
+        if (c == configs.end()) continue;
+        cells[static_cast<std::size_t>(c - configs.begin())].add(r);
+        ++n;
+      }
+      if (n == 0) continue;
+      t << "| " << sc << " | " << path << " |";
+      for (const auto& lc : cells) t << ' ' << live_row(lc) << " |";
+      t << '\n';
+    }
+  return t.str();
+}
+
 std::string render_markdown_tables(const std::vector<RunRecord>& records, const TableOptions& o) {
   std::vector<Group> per_scenario, per_path;
   auto find_or_add = [](std::vector<Group>& groups, const std::string& scenario, const std::string& path) -> Group& {
@@ -202,6 +300,16 @@ std::string render_markdown_tables(const std::vector<RunRecord>& records, const 
     md << "\nATE RMSE against the static scene along the same path (mean over the seeds both have; 1 = the movers "
           "cost nothing; `*`: some runs had no static partner or failed):\n\n";
     md << ratios;
+  }
+  std::vector<std::string> live_configs = o.configs;
+  if (o.peer) live_configs.push_back("peer");
+  const std::string live = render_live_table(records, live_configs);
+  if (!live.empty()) {
+    md << "\nFinal and live ATE (the pose tracking gave each frame, as a robot uses it), in cm: mean and worst run's "
+          "RMSE; dragged: times the live pose moved more than 10 cm against ground truth within one second, summed "
+          "over the runs (a peer's on its final trajectory); trk / LBA ms: median over runs of each run's tracking "
+          "and Local BA median:\n\n";
+    md << live;
   }
   return md.str();
 }
@@ -245,6 +353,10 @@ nlohmann::json to_json(const RunRecord& r) {
           {"fps", num(r.figures.fps)},
           {"tracking_median_ms", num(r.figures.tracking_median_ms)},
           {"wall_seconds", num(r.figures.wall_seconds)},
+          {"ate_live_rmse_m", num(r.figures.ate_live_rmse_m)},
+          {"ate_live_max_m", num(r.figures.ate_live_max_m)},
+          {"dragged_events", num(r.figures.dragged_events)},
+          {"local_ba_median_ms", num(r.figures.local_ba_median_ms)},
           {"run_dir", r.run_dir.string()},
           {"report", r.report_html.string()}};
 }

@@ -3,6 +3,7 @@
 // generated-table block of BENCHMARKS.md.
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -17,6 +18,12 @@ struct RunFigures {
   double fps;
   double tracking_median_ms;
   double wall_seconds;
+  // The live trajectory (each pose when tracking gave it) and its dragged events (eval/drag_events.hpp); for a
+  // peer, which writes only its final trajectory, the events are counted on that.
+  double ate_live_rmse_m = std::numeric_limits<double>::quiet_NaN();
+  double ate_live_max_m = std::numeric_limits<double>::quiet_NaN();
+  double dragged_events = std::numeric_limits<double>::quiet_NaN();
+  double local_ba_median_ms = std::numeric_limits<double>::quiet_NaN();
 };
 RunFigures figures_from_metrics(const nlohmann::json& metrics);
 
@@ -60,6 +67,11 @@ std::string render_markdown_tables(const std::vector<RunRecord>& records, const 
 /// per scenario x path and one over all paths. Sums over the (path, seed) pairs where both have an ATE. Empty
 /// when there are no static runs.
 std::string render_static_ratio_table(const std::vector<RunRecord>& records, const std::vector<std::string>& configs);
+
+/// Final and live ATE per scenario x path and configuration, for runs where a large mover drags the pose:
+/// mean and worst run's RMSE of each, and the dragged events summed over the runs, with tracking and Local BA
+/// medians. Empty when no record has a live trajectory.
+std::string render_live_table(const std::vector<RunRecord>& records, const std::vector<std::string>& configs);
 
 /// Replaces the text between the marker lines <!-- BENCHMARK-TABLE:BEGIN --> and <!-- BENCHMARK-TABLE:END -->
 /// in `document` with `generated`; throws InputError (naming `document_name`) when the markers are missing.

@@ -11,6 +11,7 @@
 
 #include "core/error.hpp"
 #include "eval/ate.hpp"
+#include "eval/drag_events.hpp"
 #include "io/trajectory_io.hpp"
 #include "report/bench_matrix.hpp"
 #include "report/bench_results.hpp"
@@ -93,6 +94,7 @@ RunFigures peer_figures(const SequenceSpec& seq, const fs::path& out_dir, const 
     f.ate_rmse_m = ate.stats.rmse;
     f.ate_max_m = ate.stats.max;
     f.correct_rate = correct_rate(ate.stats.count, est.size());
+    f.dragged_events = static_cast<double>(find_drag_events(gt, est).size());
     write_tum_trajectory(ate.aligned_estimate, out_dir / "CameraTrajectory_aligned.txt");
   } catch (const InputError& e) {
     error = e.what();

@@ -13,6 +13,7 @@
 
 #include "core/error.hpp"
 #include "eval/ate.hpp"
+#include "eval/drag_events.hpp"
 #include "eval/rpe.hpp"
 #include "io/atomic_file.hpp"
 #include "io/trajectory_io.hpp"
@@ -77,7 +78,14 @@ std::optional<Eigen::Isometry3d> evaluate_against(const Trajectory& gt, const Tr
     if (live.size() >= 2) {
       // What a live user (a robot) got: each pose when its frame was tracked.
       const AteResult live_ate = evaluate_ate(gt, live);
-      m["ate_live"] = {{"rmse", live_ate.stats.rmse}, {"max", live_ate.stats.max}, {"pairs", live_ate.stats.count}};
+      const std::vector<DragEvent> drags = find_drag_events(gt, live);
+      sum.ate_live_rmse = live_ate.stats.rmse;
+      sum.ate_live_max = live_ate.stats.max;
+      sum.dragged_events = drags.size();
+      nlohmann::json dj = nlohmann::json::array();
+      for (const DragEvent& d : drags) dj.push_back({{"start", d.start}, {"end", d.end}, {"peak_m", d.peak_m}});
+      m["ate_live"] = {{"rmse", live_ate.stats.rmse}, {"max", live_ate.stats.max}, {"pairs", live_ate.stats.count},
+                       {"dragged_events", drags.size()}, {"drags", dj}};
     }
     if (map_alignment) {
       // In the loaded map's own alignment to ground truth: what a robot localizing in that map gets.

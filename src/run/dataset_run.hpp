@@ -39,6 +39,8 @@ struct RunSummary {
   double wall_seconds = 0, fps = 0;
   std::optional<double> ate_rmse, ate_max;
   std::optional<double> ate_map_frame_rmse, ate_map_frame_max;  // a run on a loaded map, in the map's alignment
+  std::optional<double> ate_live_rmse, ate_live_max;  // the poses as tracking gave them
+  std::size_t dragged_events = 0;  // the live pose jumped > 10 cm against ground truth within 1 s (eval/drag_events)
   std::string ate_note;          // why there is no ATE although ground truth exists
   std::optional<std::string> failure;  // the run tracked too little: the share and the likely cause
   bool interrupted = false;      // stopped through RunOptions::stop; the outputs hold what was tracked

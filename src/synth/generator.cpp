@@ -28,7 +28,7 @@
 namespace varslam::synth {
 
 std::vector<std::string> scenario_names() {
-  return {"static", "walking", "unknown_box", "obstructing_box", "balloon", "mixed"};
+  return {"static", "walking", "unknown_box", "obstructing_box", "balloon", "mixed", "large_box", "large_box_people"};
 }
 
 namespace {

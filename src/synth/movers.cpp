@@ -186,8 +186,22 @@ bool ObjectScript::pose_at(double t, Eigen::Isometry3d& pose) const {
       }
       return false;
     }
+    case Kind::LargeBox:
+      for (const auto& e : large_episodes)
+        if (e.active(t)) {
+          pose = e.pose_at(t);
+          return true;
+        }
+      return false;
   }
   return false;
+}
+
+double ObjectScript::size_at(double t) const {
+  if (kind == Kind::LargeBox)
+    for (const auto& e : large_episodes)
+      if (e.active(t)) return e.size;
+  return size;
 }
 
 namespace {
@@ -210,7 +224,7 @@ class MoverRng {
 };
 
 // Stream numbers of the mover groups (stable: changing one changes that mover only).
-enum Stream : std::uint64_t { kPeopleCount = 1, kCarriedBox = 2, kBalloon = 3, kObstructingBox = 4, kFirstPerson = 10 };
+enum Stream : std::uint64_t { kPeopleCount = 1, kCarriedBox = 2, kBalloon = 3, kObstructingBox = 4, kLargeBox = 5, kFirstPerson = 10 };
 
 PersonScript plan_person(std::size_t i, const ViewAnchor& anchor, std::uint64_t seed) {
   MoverRng g(mix_seed(seed, kFirstPerson + i), anchor);
@@ -278,6 +292,16 @@ ObjectScript plan_obstructing_box(const ViewAnchor& anchor, double duration, con
   return o;
 }
 
+ObjectScript plan_large_box(double duration, const Movers::PoseAt& pose_at, std::uint64_t seed) {
+  std::mt19937_64 rng(mix_seed(seed, kLargeBox));
+  ObjectScript o;
+  o.kind = ObjectScript::Kind::LargeBox;
+  o.size = 1.0;  // texture scale; each episode has its own edge
+  o.large_episodes = plan_large_box_episodes(duration, pose_at, rng);
+  o.look_seed = rng();
+  return o;
+}
+
 }  // namespace
 
 Movers Movers::plan_all(const ViewAnchor& anchor, double floor_y, double duration, const PoseAt& pose_at,
@@ -288,14 +312,15 @@ Movers Movers::plan_all(const ViewAnchor& anchor, double floor_y, double duratio
   std::mt19937_64 count_rng(mix_seed(seed, kPeopleCount));
   m.walking_people_ = std::uniform_real_distribution<double>(0, 1)(count_rng) < 0.5 ? 2 : 3;
   m.objects_ = {plan_carried_box(anchor, floor_y, seed), plan_balloon(anchor, floor_y, seed),
-                plan_obstructing_box(anchor, duration, pose_at, seed)};
+                plan_obstructing_box(anchor, duration, pose_at, seed), plan_large_box(duration, pose_at, seed)};
   return m;
 }
 
 Movers Movers::select(const std::string& scenario) const {
   Movers m;
   m.floor_y_ = floor_y_;
-  const std::size_t n_people = scenario == "walking" ? walking_people_ : scenario == "mixed" ? 2 : 0;
+  const bool two_people = scenario == "mixed" || scenario == "large_box_people";
+  const std::size_t n_people = scenario == "walking" ? walking_people_ : two_people ? 2 : 0;
   m.people_.assign(people_.begin(), people_.begin() + static_cast<std::ptrdiff_t>(std::min(n_people, people_.size())));
   m.walking_people_ = m.people_.size();
   auto wanted = [&](ObjectScript::Kind k) {
@@ -303,6 +328,7 @@ Movers Movers::select(const std::string& scenario) const {
       case ObjectScript::Kind::CarriedBox: return scenario == "unknown_box" || scenario == "mixed";
       case ObjectScript::Kind::Balloon: return scenario == "balloon" || scenario == "mixed";
       case ObjectScript::Kind::ObstructingBox: return scenario == "obstructing_box";
+      case ObjectScript::Kind::LargeBox: return scenario == "large_box" || scenario == "large_box_people";
     }
     return false;
   };
@@ -386,7 +412,7 @@ void Movers::primitives_at(double t, std::vector<Primitive>& out) const {
     if (o.kind == ObjectScript::Kind::Balloon) {
       out.push_back(sphere(T.translation(), o.size / 2, o.material, o.id, T.rotation()));
     } else {
-      const double h = o.size / 2;
+      const double h = o.size_at(t) / 2;
       out.push_back(obb(T.translation(), {h, h * 0.85, h}, T.rotation(), o.material, o.id));
     }
   }
@@ -421,6 +447,13 @@ nlohmann::json Movers::describe() const {
         e["distance_m"] = o.distance;
         nlohmann::json eps = nlohmann::json::array();
         for (const auto& ep : o.episodes) eps.push_back({{"start_s", ep.start}, {"length_s", ep.length}});
+        e["episodes"] = eps;
+        break;
+      }
+      case ObjectScript::Kind::LargeBox: {
+        e["type"] = "large_box";
+        nlohmann::json eps = nlohmann::json::array();
+        for (const auto& ep : o.large_episodes) eps.push_back(ep.describe());
         e["episodes"] = eps;
         break;
       }

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "synth/large_box.hpp"
 #include "synth/primitives.hpp"
 #include "synth/scene.hpp"
 
@@ -30,7 +31,7 @@ struct PersonScript {
 };
 
 struct ObjectScript {
-  enum class Kind { CarriedBox, Balloon, ObstructingBox };
+  enum class Kind { CarriedBox, Balloon, ObstructingBox, LargeBox };
   Kind kind = Kind::CarriedBox;
   std::uint8_t id = kFirstObjectId;
   double size = 0.4;  // box edge or balloon diameter
@@ -47,7 +48,12 @@ struct ObjectScript {
   };
   std::vector<Episode> episodes;
   double distance = 1.1;
+  // LargeBox: its episodes, each with its own size and precomputed track.
+  std::vector<LargeBoxEpisode> large_episodes;
   std::uint64_t look_seed = 0;  // texture
+
+  /// Edge length at t (a large box's size changes from episode to episode).
+  double size_at(double t) const;
 
   /// Pose of the object at t; false when it is not in the scene (obstructing box between episodes).
   bool pose_at(double t, Eigen::Isometry3d& pose) const;
@@ -57,7 +63,7 @@ class Movers {
  public:
   using PoseAt = std::function<Eigen::Isometry3d(double)>;
 
-  /// Every mover any scenario uses (three people, carried box, balloon, obstructing box), each from its own RNG
+  /// Every mover any scenario uses (three people, carried box, balloon, obstructing box, large box), each from its own RNG
   /// stream, so a mover does not depend on which others exist. pose_at(t) = camera-to-world pose at t seconds.
   static Movers plan_all(const ViewAnchor& anchor, double floor_y, double duration, const PoseAt& pose_at,
                          std::uint64_t seed);

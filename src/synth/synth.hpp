@@ -15,7 +15,8 @@ namespace varslam::synth {
 inline constexpr int kGeneratorVersion = 3;
 
 struct SynthConfig {
-  std::string scenario = "walking";  // static | walking | unknown_box | obstructing_box | balloon | mixed
+  std::string scenario = "walking";  // static | walking | unknown_box | obstructing_box | balloon | mixed |
+                                     // large_box | large_box_people (20-s large-movers sequences)
   double seconds = 10.0;
   double fps = 30.0;
   std::uint64_t seed = 1;

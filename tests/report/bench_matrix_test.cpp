@@ -6,6 +6,8 @@
 
 #include "core/error.hpp"
 #include "io/trajectory_io.hpp"
+#include "report/bench_runner.hpp"
+#include "synth/synth.hpp"
 
 namespace varslam::report {
 namespace {
@@ -43,6 +45,28 @@ TEST(Configurations, OverridesMatchTheAblation) {
   EXPECT_TRUE(contains(full_yolo, "semantic.detector=yolo"));
   EXPECT_THROW(configuration_overrides(configuration_by_name("full"), "boxes", {}), InputError);
   EXPECT_THROW(configuration_overrides(configuration_by_name("full"), "hog?", {}), InputError);
+}
+
+TEST(NamedMatrices, DefaultIsTheQuickCheckAndLargeMoversTheLongOne) {
+  const NamedMatrix& quick = matrix_by_name("default");
+  const BenchOptions defaults;
+  EXPECT_EQ(quick.scenarios, defaults.scenarios);
+  EXPECT_EQ(quick.seeds, defaults.seeds);
+  EXPECT_DOUBLE_EQ(quick.seconds, 3.0);
+  const NamedMatrix& large = matrix_by_name("large_movers");
+  EXPECT_EQ(large.scenarios, (std::vector<std::string>{"large_box", "large_box_people"}));
+  EXPECT_EQ(large.seeds.size(), 5u);
+  EXPECT_GE(large.paths.size(), 3u);
+  EXPECT_DOUBLE_EQ(large.seconds, 20.0);
+  // Every scenario it names is one the generator knows.
+  const auto known = synth::scenario_names();
+  for (const auto& s : large.scenarios) EXPECT_NE(std::find(known.begin(), known.end(), s), known.end()) << s;
+  try {
+    matrix_by_name("large-movers");
+    FAIL() << "an unknown matrix must be refused";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("known: default, large_movers"), std::string::npos) << e.what();
+  }
 }
 
 TEST(CameraPath, ShortNames) {

@@ -94,6 +94,43 @@ TEST(MarkdownTables, RatioToStaticPairsSeedsAlongTheSamePath) {
   EXPECT_TRUE(render_static_ratio_table({rec("walking", "pa", 1, "full", 0.03)}, {"full"}).empty());  // no static
 }
 
+TEST(FiguresFromMetrics, ReadsTheLiveTrajectoryAndLocalBaKeys) {
+  const nlohmann::json m = {{"ate", {{"rmse", 0.1}}},
+                            {"ate_live", {{"rmse", 0.4}, {"max", 1.2}, {"dragged_events", 3}}},
+                            {"timings", {{"local_ba", {{"median_ms", 120.0}}}}}};
+  const RunFigures f = figures_from_metrics(m);
+  EXPECT_DOUBLE_EQ(f.ate_live_rmse_m, 0.4);
+  EXPECT_DOUBLE_EQ(f.ate_live_max_m, 1.2);
+  EXPECT_DOUBLE_EQ(f.dragged_events, 3.0);
+  EXPECT_DOUBLE_EQ(f.local_ba_median_ms, 120.0);
+}
+
+TEST(LiveTable, MeanAndWorstRunOfFinalAndLiveWithDraggedEventsSummed) {
+  auto live = [](const std::string& path, std::uint64_t seed, double fin, double lv, double drags, double lba) {
+    RunRecord r = rec("large_box", path, seed, "full", fin);
+    r.figures.ate_live_rmse_m = lv;
+    r.figures.dragged_events = drags;
+    r.figures.local_ba_median_ms = lba;
+    return r;
+  };
+  std::vector<RunRecord> records = {live("fr2", 1, 0.02, 0.03, 0, 100), live("fr2", 2, 0.04, 0.09, 2, 140),
+                                    live("bonn", 1, 0.10, 0.50, 5, 200)};
+  RunRecord peer = rec("large_box", "fr2", 1, "peer", 0.30);
+  peer.figures.dragged_events = 4;
+  records.push_back(peer);
+  EXPECT_TRUE(render_live_table({rec("walking", "fr2", 1, "full", 0.01)}, {"full"}).empty());
+  const std::string t = render_live_table(records, {"full", "peer"});
+  // fr2: final mean 3, worst 4; live mean 6, worst 9; 2 drags; tracking median 30; Local BA median 120.
+  EXPECT_NE(t.find("| large_box | fr2 | 3.00 | 4.00 | 6.00 | 9.00 | 2 | 30.0 | 120 | 30.00 | 30.00 | - | - | 4 |"),
+            std::string::npos)
+      << t;
+  EXPECT_NE(t.find("| large_box | bonn | 10.00 | 10.00 | 50.00 | 50.00 | 5 |"), std::string::npos) << t;
+  // Over all paths: mean of the three runs, worst run, drags summed.
+  EXPECT_NE(t.find("| large_box | all | 5.33 | 10.00 | 20.67 | 50.00 | 7 |"), std::string::npos) << t;
+  EXPECT_LT(t.find("| fr2 |"), t.find("| bonn |"));
+  EXPECT_LT(t.find("| bonn |"), t.find("| all |"));
+}
+
 TEST(Markers, ReplacesOnlyTheGeneratedBlock) {
   const std::string doc = std::string("# B\nintro\n") + kTableBeginMarker + "\nold table\n" + kTableEndMarker + "\nafter\n";
   const std::string out = replace_between_markers(doc, "new table", "B.md");
