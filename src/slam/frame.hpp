@@ -69,12 +69,15 @@ struct Frame {
   bool has_pose = false;
   std::vector<MapPointPtr> map_points;  // per keypoint, null where unmatched
   std::vector<bool> outlier;
+  // Per keypoint: on a mover close to the camera (Tracker's near-mover check); no map point or temporary depth
+  // point is made from it.
+  std::vector<bool> on_mover;
   std::shared_ptr<KeyFrame> reference_kf;
 
   Frame() = default;
   Frame(long frame_id, double t, std::shared_ptr<const FrameFeatures> f)
       : id(frame_id), timestamp(t), features(std::move(f)),
-        map_points(features->size()), outlier(features->size(), false) {}
+        map_points(features->size()), outlier(features->size(), false), on_mover(features->size(), false) {}
 
   Eigen::Vector3d camera_center() const { return T_cw.inverse().translation(); }
   int num_tracked() const;  // matched, non-outlier, non-bad

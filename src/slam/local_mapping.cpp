@@ -171,7 +171,7 @@ void LocalMapper::cull_recent_points(const KeyFramePtr& kf) {
     const long age = kf->id() - mp->first_keyframe_id();
     if (mp->is_bad()) {
       it = recent_points_.erase(it);
-    } else if (mp->found_ratio() < cfg_.min_found_ratio || (age >= 2 && mp->num_observations() <= kMinObservations)) {
+    } else if (mp->moving() || mp->found_ratio() < cfg_.min_found_ratio || (age >= 2 && mp->num_observations() <= kMinObservations)) {
       mp->set_bad();
       ++culled;
       it = recent_points_.erase(it);
@@ -283,11 +283,17 @@ void LocalMapper::local_ba(const KeyFramePtr& kf) {
     }
   std::vector<MapPointPtr> points;
   for (const auto& k : local)
-    for (const auto& mp : k->map_points())
-      if (mp && !mp->is_bad() && mp->ba_local_kf != kf->id()) {
-        mp->ba_local_kf = kf->id();
-        points.push_back(mp);
+    for (const auto& mp : k->map_points()) {
+      if (!mp || mp->is_bad() || mp->ba_local_kf == kf->id()) continue;
+      mp->ba_local_kf = kf->id();
+      // A point tracking saw moving with a near mover is no structure: cull it before BA can lean on it.
+      if (mp->moving()) {
+        mp->set_bad();
+        ++current_.culled_points;
+        continue;
       }
+      points.push_back(mp);
+    }
   // Fixed keyframes: the ones seeing most of the window's points, capped like the window itself (in a small
   // room every keyframe sees the window, and each would add residuals without adding much constraint).
   std::map<KeyFramePtr, int, IdLess> fixed_count;

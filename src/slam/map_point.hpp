@@ -76,6 +76,10 @@ class MapPoint {
   /// Frames whose pose optimisation matched the point and flagged it an outlier (what a viewer colours by).
   void increase_flagged() { flagged_.fetch_add(1); }
   int flagged() const { return flagged_.load(); }
+  /// Tracking found the point on a mover close to the camera (slam/near_mover.hpp): it is matched no more, Local
+  /// BA leaves it out and local mapping culls it.
+  void mark_moving() { moving_.store(true); }
+  bool moving() const { return moving_.load(); }
   double found_ratio() const { return static_cast<double>(found_.load()) / std::max(1, visible_.load()); }
   /// A point tracking can lean on in frame `frame_id`: a real map point (not a temporary depth point), found as
   /// an inlier in at least `min_found` frames and created at least `min_age` frames before.
@@ -107,6 +111,7 @@ class MapPoint {
   std::shared_ptr<MapPoint> replaced_by_;
   double min_distance_ = 0, max_distance_ = 0;
   std::atomic<int> visible_{1}, found_{1}, flagged_{0};
+  std::atomic<bool> moving_{false};
   std::atomic<bool> bad_{false};
 };
 

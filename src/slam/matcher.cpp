@@ -94,7 +94,7 @@ int match_last_frame(Frame& cur, const Frame& last, double radius) {
   std::vector<std::pair<int, float>> rot;
   for (std::size_t i = 0; i < last.map_points.size(); ++i) {
     const MapPointPtr& mp = last.map_points[i];
-    if (!mp || last.outlier[i] || mp->is_bad()) continue;
+    if (!mp || last.outlier[i] || mp->is_bad() || mp->moving()) continue;
     const Eigen::Vector3d pc = cur.T_cw * mp->position();
     if (pc.z() <= 0) continue;
     const Eigen::Vector2d uv = F.camera.project(pc);
@@ -129,7 +129,7 @@ int match_local_map(Frame& cur, const std::vector<MapPointPtr>& points, double r
   const Eigen::Vector3d center = T_wc.translation();
   int n = 0;
   for (const MapPointPtr& mp : points) {
-    if (mp->is_bad() || (tracking && mp->last_seen_frame == cur.id)) continue;
+    if (mp->is_bad() || mp->moving() || (tracking && mp->last_seen_frame == cur.id)) continue;
     const Eigen::Vector3d pw = mp->position();
     const Eigen::Vector3d pc = cur.T_cw * pw;
     if (pc.z() <= 0) continue;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <mutex>
 #include <shared_mutex>
 #include <utility>
@@ -208,6 +209,7 @@ void Tracker::refresh_last_frame() {
   int n = 0;
   for (const auto& [d, i] : by_depth) {
     const MapPointPtr& mp = last_.map_points[i];
+    if (last_.on_mover[i]) continue;
     if (!mp || mp->num_observations() < 1) {
       auto tmp = std::make_shared<MapPoint>(-1, T_wc * L.unproject(i), nullptr);
       tmp->set_descriptor(L.descriptors.row(i));
@@ -241,8 +243,9 @@ int Tracker::optimize_and_discard(Frame& cur, FrameTimings& t) {
   // The dedicated 6-DoF solver gives the same pose as Ceres (tested against it) at 1.5-2x less cost.
   pc.solver = optim::PoseSolver::Dedicated;
   pc.observer = cfg_.tracking.pose_observer;
-  const auto res =
+  auto res =
       optim::optimize_pose(camera_, cur.T_cw, p.points, p.observations, pc, trust_established ? &young : nullptr);
+  if (cfg_.tracking.near_mover_check) drop_near_mover(cur, p, pc, trust_established ? &young : nullptr, res);
   cur.has_pose = true;
   int inliers = 0;
   for (std::size_t k = 0; k < idx.size(); ++k) {
@@ -251,6 +254,60 @@ int Tracker::optimize_and_discard(Frame& cur, FrameTimings& t) {
   }
   t.pose_ms += ms_since(t0);
   return inliers;
+}
+
+void Tracker::drop_near_mover(Frame& cur, const FramePoseProblem& p, const optim::PoseOptimConfig& pc,
+                              const std::vector<bool>* young, optim::PoseOptimResult& res) {
+  const NearMoverVerdict v =
+      check_near_mover(camera_, cur.T_cw, p.points, p.observations, res.outlier, pc, cfg_.tracking.near_mover);
+  if (!v.moving) return;
+  // Solve again on everything but the mover, from the far cluster's pose.
+  std::vector<Eigen::Vector3d> points;
+  std::vector<optim::Observation> obs;
+  std::vector<bool> kept_young;
+  std::vector<std::size_t> kept;
+  for (std::size_t k = 0; k < p.points.size(); ++k) {
+    if (v.mover[k]) continue;
+    kept.push_back(k);
+    points.push_back(p.points[k]);
+    obs.push_back(p.observations[k]);
+    if (young) kept_young.push_back((*young)[k]);
+  }
+  Eigen::Isometry3d T = v.T_far;
+  const optim::PoseOptimResult kept_res = optim::optimize_pose(camera_, T, points, obs, pc, young ? &kept_young : nullptr);
+  cur.T_cw = T;
+  res.outlier.assign(p.points.size(), true);
+  for (std::size_t j = 0; j < kept.size(); ++j) res.outlier[kept[j]] = kept_res.outlier[j];
+  res.inliers = kept_res.inliers;
+  const FrameFeatures& F = *cur.features;
+  Eigen::AlignedBox2f region;
+  float near = std::numeric_limits<float>::max(), far = 0.0f;
+  for (std::size_t k = 0; k < p.points.size(); ++k) {
+    if (!v.mover[k]) continue;
+    const int i = p.keypoints[k];
+    cur.on_mover[i] = true;
+    const MapPointPtr& mp = cur.map_points[i];
+    if (mp->num_observations() > 0) mp->mark_moving();
+    region.extend(Eigen::Vector2f(F.keypoints[i].pt.x, F.keypoints[i].pt.y));
+    if (F.has_depth(i)) {
+      near = std::min(near, F.depth[i]);
+      far = std::max(far, F.depth[i]);
+    }
+  }
+  // Unmatched keypoints on the mover too: inside its image region and depth range (with a margin), as the person
+  // filter does with a detector's box.
+  constexpr float kMarginPx = 10.0f, kDepthMargin = 0.15f;
+  region.min().array() -= kMarginPx;
+  region.max().array() += kMarginPx;
+  for (std::size_t i = 0; i < F.size(); ++i)
+    if (F.has_depth(i) && F.depth[i] >= (1 - kDepthMargin) * near && F.depth[i] <= (1 + kDepthMargin) * far &&
+        region.contains(Eigen::Vector2f(F.keypoints[i].pt.x, F.keypoints[i].pt.y)))
+      cur.on_mover[i] = true;
+  ++near_mover_frames_;
+  spdlog::debug("frame {}: near mover ({} of {} near matches at {:.2f} m move against {} far at {:.2f} m; joint "
+                "outliers near {:.2f} far {:.2f}; near median chi2 {:.1f} gates)",
+                cur.id, v.moving_points, v.near, v.near_depth, v.far, v.far_depth, v.near_joint_outliers,
+                v.far_joint_outliers, v.near_median_chi2);
 }
 
 bool Tracker::track_initial_pose(Frame& cur, FrameTimings& t) {
@@ -512,6 +569,7 @@ KeyFramePtr Tracker::insert_keyframe_with_depth_points(Frame& cur, bool all_dept
   int n = 0;
   for (const auto& [d, i] : by_depth) {
     const MapPointPtr& existing = cur.map_points[i];
+    if (cur.on_mover[i]) continue;
     if (!existing || existing->num_observations() < 1) {
       auto mp = std::make_shared<MapPoint>(map_.next_map_point_id(), T_wc * F.unproject(i), kf);
       mp->add_observation(kf, i, true);

@@ -16,6 +16,8 @@
 
 namespace varslam::slam {
 
+struct FramePoseProblem;
+
 enum class TrackState { NotInitialized, Ok, Lost };
 
 /// Where tracking hands its keyframes (local mapping, directly or through a queue).
@@ -100,6 +102,8 @@ class Tracker {
   const Frame& last_frame() const { return last_; }
   int segments() const { return segments_; }
   int relocalizations() const { return relocalizations_; }
+  /// Pose solves the near-mover check changed (a frame can count more than once: motion model, then local map).
+  long near_mover_frames() const { return near_mover_frames_; }
   std::shared_ptr<const ScaleInfo> scale() const { return scale_; }
 
  private:
@@ -117,6 +121,10 @@ class Tracker {
   bool relocalize(Frame& cur, FrameTimings& t);
   bool track_local_map(Frame& cur, FrameTimings& t);
   int optimize_and_discard(Frame& cur, FrameTimings& t);
+  /// The near-mover check (slam/near_mover.hpp) on a solved frame: when the near matches move against the far
+  /// ones, solves again without them and marks them (and the keypoints on the mover) so nothing is built on them.
+  void drop_near_mover(Frame& cur, const FramePoseProblem& p, const optim::PoseOptimConfig& pc,
+                       const std::vector<bool>* young, optim::PoseOptimResult& res);
   void update_local_map(Frame& cur);
   bool need_keyframe(const Frame& cur, int inliers) const;
   void create_keyframe(Frame& cur);
@@ -150,6 +158,7 @@ class Tracker {
   bool awaiting_loaded_map_ = false;  // started on a loaded map and not relocalized in it yet
   bool localization_only_ = false;
   int relocalizations_ = 0;
+  long near_mover_frames_ = 0;
   std::optional<Relocalization> relocalized_;  // of the frame being tracked, moved into its TrackOutcome
   long seen_corrections_ = 0;  // map_.corrections() when the last frame was last re-anchored
   std::vector<KeyFramePtr> local_keyframes_;
