@@ -13,7 +13,10 @@ int main(int argc, char** argv) {
   CLI::App app{"varslam: RGB-D visual SLAM that stays accurate where things move"};
   app.require_subcommand(1);
   // Subcommands run inside parse(), so the log level is set as soon as the flag is parsed.
-  app.add_flag_callback("-v,--verbose", [] { spdlog::set_level(spdlog::level::debug); }, "Debug logging");
+  app.add_flag_function(
+      "-v,--verbose",
+      [](std::int64_t count) { spdlog::set_level(count > 1 ? spdlog::level::trace : spdlog::level::debug); },
+      "Debug logging (-vv: also per-frame decisions that changed nothing)");
   varslam::cli::add_demo_command(app);
   varslam::cli::add_run_command(app);
   varslam::cli::add_eval_command(app);

@@ -368,6 +368,7 @@ SlamSummary Slam::summary() const {
     s.map_points = system_->map().num_map_points();
     s.segments = system_->tracker().segments();
     s.relocalizations = system_->tracker().relocalizations();
+    s.near_mover_solves = system_->tracker().near_mover_frames();
   }
   s.detector = masker_ ? masker_->detector_name() : "none";
   s.detector_runs = masker_ ? masker_->detector_runs() : 0;

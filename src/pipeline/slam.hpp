@@ -47,6 +47,7 @@ struct SlamOptions {
 struct SlamSummary {
   std::size_t frames = 0, tracked = 0, keyframes = 0, map_points = 0;
   int segments = 0, relocalizations = 0;
+  long near_mover_solves = 0;  // pose solves the near-mover check changed (tracking.near_mover_check)
   std::string detector;        // "none" without the person filter
   long detector_runs = 0;
   bool detector_asynchronous = false;

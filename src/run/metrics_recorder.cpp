@@ -87,6 +87,7 @@ nlohmann::json MetricsRecorder::metrics(const Slam& slam) const {
   m["tracked_share"] = frames() ? static_cast<double>(tracked_) / static_cast<double>(frames()) : 0.0;
   m["map_segments"] = s.segments;
   m["relocalizations"] = s.relocalizations;
+  m["near_mover_solves"] = s.near_mover_solves;
   m["keyframes"] = s.keyframes;
   m["map_points"] = s.map_points;
   m["triangulated_points"] = triangulated_;

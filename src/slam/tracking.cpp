@@ -260,7 +260,16 @@ void Tracker::drop_near_mover(Frame& cur, const FramePoseProblem& p, const optim
                               const std::vector<bool>* young, optim::PoseOptimResult& res) {
   const NearMoverVerdict v =
       check_near_mover(camera_, cur.T_cw, p.points, p.observations, res.outlier, pc, cfg_.tracking.near_mover);
-  if (!v.moving) return;
+  if (!v.moving) {
+    if (!v.split)
+      spdlog::trace("frame {}: no near-mover test ({} near at {:.2f} m, {} far at {:.2f} m, {} far inliers)", cur.id,
+                    v.near, v.near_depth, v.far, v.far_depth, v.far_inliers);
+    if (v.split)
+      spdlog::trace("frame {}: near cluster kept ({} of {} near at {:.2f} m off, median chi2 {:.1f} gates; {} far at "
+                    "{:.2f} m)",
+                    cur.id, v.moving_points, v.near, v.near_depth, v.near_median_chi2, v.far, v.far_depth);
+    return;
+  }
   // Solve again on everything but the mover, from the far cluster's pose.
   std::vector<Eigen::Vector3d> points;
   std::vector<optim::Observation> obs;
@@ -279,9 +288,14 @@ void Tracker::drop_near_mover(Frame& cur, const FramePoseProblem& p, const optim
   res.outlier.assign(p.points.size(), true);
   for (std::size_t j = 0; j < kept.size(); ++j) res.outlier[kept[j]] = kept_res.outlier[j];
   res.inliers = kept_res.inliers;
+  ++near_mover_frames_;
+  spdlog::debug("frame {}: near mover ({} of {} near matches at {:.2f} m move against {} far at {:.2f} m; joint "
+                "outliers near {:.2f} far {:.2f}; near median chi2 {:.1f} gates)",
+                cur.id, v.moving_points, v.near, v.near_depth, v.far, v.far_depth, v.near_joint_outliers,
+                v.far_joint_outliers, v.near_median_chi2);
   const FrameFeatures& F = *cur.features;
   Eigen::AlignedBox2f region;
-  float near = std::numeric_limits<float>::max(), far = 0.0f;
+  std::vector<float> depths;
   for (std::size_t k = 0; k < p.points.size(); ++k) {
     if (!v.mover[k]) continue;
     const int i = p.keypoints[k];
@@ -289,25 +303,19 @@ void Tracker::drop_near_mover(Frame& cur, const FramePoseProblem& p, const optim
     const MapPointPtr& mp = cur.map_points[i];
     if (mp->num_observations() > 0) mp->mark_moving();
     region.extend(Eigen::Vector2f(F.keypoints[i].pt.x, F.keypoints[i].pt.y));
-    if (F.has_depth(i)) {
-      near = std::min(near, F.depth[i]);
-      far = std::max(far, F.depth[i]);
-    }
+    if (F.has_depth(i)) depths.push_back(F.depth[i]);
   }
+  if (depths.empty()) return;
+  const auto [near, far] = std::minmax_element(depths.begin(), depths.end());
   // Unmatched keypoints on the mover too: inside its image region and depth range (with a margin), as the person
   // filter does with a detector's box.
   constexpr float kMarginPx = 10.0f, kDepthMargin = 0.15f;
   region.min().array() -= kMarginPx;
   region.max().array() += kMarginPx;
   for (std::size_t i = 0; i < F.size(); ++i)
-    if (F.has_depth(i) && F.depth[i] >= (1 - kDepthMargin) * near && F.depth[i] <= (1 + kDepthMargin) * far &&
+    if (F.has_depth(i) && F.depth[i] >= (1 - kDepthMargin) * *near && F.depth[i] <= (1 + kDepthMargin) * *far &&
         region.contains(Eigen::Vector2f(F.keypoints[i].pt.x, F.keypoints[i].pt.y)))
       cur.on_mover[i] = true;
-  ++near_mover_frames_;
-  spdlog::debug("frame {}: near mover ({} of {} near matches at {:.2f} m move against {} far at {:.2f} m; joint "
-                "outliers near {:.2f} far {:.2f}; near median chi2 {:.1f} gates)",
-                cur.id, v.moving_points, v.near, v.near_depth, v.far, v.far_depth, v.near_joint_outliers,
-                v.far_joint_outliers, v.near_median_chi2);
 }
 
 bool Tracker::track_initial_pose(Frame& cur, FrameTimings& t) {

@@ -18,7 +18,8 @@ struct Scene {
 // The camera at T_cw sees `n_far` wall points (depth 3.5-4.5 m) and `n_near` box points (0.9-1.1 m); the box
 // points are observed where they would be after the box moved by `box_motion` (world frame). Noise in pixels.
 Scene make_scene(const PinholeCamera& cam, const Eigen::Isometry3d& T_cw, int n_far, int n_near,
-                 const Eigen::Vector3d& box_motion, double noise_px, unsigned seed = 3) {
+                 const Eigen::Vector3d& box_motion, double noise_px, unsigned seed = 3, int n_desk = 0,
+                 double far_depth = 4.0) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-1, 1);
   std::normal_distribution<double> n(0, noise_px);
@@ -31,14 +32,16 @@ Scene make_scene(const PinholeCamera& cam, const Eigen::Isometry3d& T_cw, int n_
     const Eigen::Vector3d seen_c = T_cw * (p_w + motion);
     optim::Observation o;
     o.uv = cam.project(seen_c) + Eigen::Vector2d(n(rng), n(rng));
-    o.u_right = o.uv.x() - cam.bf / seen_c.z();
+    o.u_right = o.uv.x() - cam.bf / seen_c.z() + 0.1 * n(rng);
     o.disparity_weight = 10;
     s.points_w.push_back(p_w);
     s.obs.push_back(o);
     s.near.push_back(near);
   };
-  for (int i = 0; i < n_far; ++i) add(3.5, 4.5, 0.55, Eigen::Vector3d::Zero(), false);
+  for (int i = 0; i < n_far; ++i) add(far_depth - 0.5, far_depth + 0.5, 0.55, Eigen::Vector3d::Zero(), false);
   for (int i = 0; i < n_near; ++i) add(0.9, 1.1, 0.3, box_motion, true);
+  // A static desk between the box and the wall (not a mover: near[k] stays false).
+  for (int i = 0; i < n_desk; ++i) add(1.4, 1.8, 0.5, Eigen::Vector3d::Zero(), false);
   return s;
 }
 
