@@ -206,9 +206,8 @@ PoseOptimResult optimize_pose(const PinholeCamera& cam, Eigen::Isometry3d& T_cw,
     // Re-classify every observation (inactive ones too: they can come back).
     for (std::size_t i = 0; i < n; ++i) {
       const Eigen::Vector3d p_c = T_cw * points_w[i];
-      const int dof = whitened_residual(cam, obs[i], p_c, e, nullptr);
-      double chi2 = 0;
-      for (int k = 0; k < dof; ++k) chi2 += e[k] * e[k];
+      int dof = 0;
+      const double chi2 = whitened_chi2(cam, obs[i], p_c, dof);
       result.outlier[i] = p_c.z() <= 0.0 || chi2 > chi2_threshold(dof);
     }
   }

@@ -48,6 +48,15 @@ class PoseManifold final : public ceres::Manifold {
 int whitened_residual(const PinholeCamera& cam, const Observation& obs, const Eigen::Vector3d& p_c, double e[3],
                       Eigen::Matrix3d* de_dpc);
 
+/// Squared whitened residual (what the chi-square gates test) of one observation of p_c; dof is set to 2 or 3.
+inline double whitened_chi2(const PinholeCamera& cam, const Observation& obs, const Eigen::Vector3d& p_c, int& dof) {
+  double e[3];
+  dof = whitened_residual(cam, obs, p_c, e, nullptr);
+  double chi2 = 0;
+  for (int k = 0; k < dof; ++k) chi2 += e[k] * e[k];
+  return chi2;
+}
+
 /// d p_c / d [w; v] for the left update at p_c = T_cw * p_w: [-[p_c]x, I].
 Eigen::Matrix<double, 3, 6> dpc_dpose(const Eigen::Vector3d& p_c);
 

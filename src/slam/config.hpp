@@ -50,8 +50,8 @@ struct TrackingConfig {
   int established_found = setting_keys::int_default("tracking.established_found");
   int established_age = setting_keys::int_default("tracking.established_age");
   bool near_mover_check = setting_keys::bool_default("tracking.near_mover_check");
-  NearMoverConfig near_mover{setting_keys::real_default("tracking.near_mover_depth_ratio"), 30,
-                             setting_keys::real_default("tracking.near_mover_share"), 20};
+  NearMoverConfig near_mover{.min_depth_ratio = setting_keys::real_default("tracking.near_mover_depth_ratio"),
+                             .min_moving_share = setting_keys::real_default("tracking.near_mover_share")};
   int min_inliers_local_map = setting_keys::int_default("tracking.min_inliers");
   int max_local_keyframes = setting_keys::int_default("tracking.max_local_keyframes");
   int lost_frames_before_reinit = setting_keys::int_default("tracking.lost_frames_before_reinit");

@@ -54,10 +54,8 @@ double gated_chi2(const PinholeCamera& cam, const Eigen::Isometry3d& T_cw, const
                   const optim::Observation& o) {
   const Eigen::Vector3d p_c = T_cw * p_w;
   if (p_c.z() <= 0) return std::numeric_limits<double>::infinity();
-  double e[3];
-  const int dof = optim::whitened_residual(cam, o, p_c, e, nullptr);
-  double chi2 = 0;
-  for (int i = 0; i < dof; ++i) chi2 += e[i] * e[i];
+  int dof = 0;
+  const double chi2 = optim::whitened_chi2(cam, o, p_c, dof);
   return chi2 / optim::chi2_threshold(dof);
 }
 
@@ -65,8 +63,8 @@ double gated_chi2(const PinholeCamera& cam, const Eigen::Isometry3d& T_cw, const
 
 NearMoverVerdict check_near_mover(const PinholeCamera& cam, const Eigen::Isometry3d& T_cw,
                                   const std::vector<Eigen::Vector3d>& points_w,
-                                  const std::vector<optim::Observation>& obs, const std::vector<bool>& joint_outlier,
-                                  const optim::PoseOptimConfig& pose, const NearMoverConfig& cfg) {
+                                  const std::vector<optim::Observation>& obs, const optim::PoseOptimConfig& pose,
+                                  const NearMoverConfig& cfg) {
   NearMoverVerdict v;
   std::vector<double> depth(points_w.size());
   for (std::size_t k = 0; k < points_w.size(); ++k) depth[k] = (T_cw * points_w[k]).z();
@@ -75,24 +73,18 @@ NearMoverVerdict check_near_mover(const PinholeCamera& cam, const Eigen::Isometr
   std::vector<Eigen::Vector3d> far_points;
   std::vector<optim::Observation> far_obs;
   std::vector<std::size_t> near_idx;
-  int near_rejected = 0, far_rejected = 0;
   for (std::size_t k = 0; k < points_w.size(); ++k) {
     if (depth[k] <= 0) continue;
     if (depth[k] < v.split_depth) {
       near_idx.push_back(k);
-      near_rejected += joint_outlier[k];
     } else {
       far_points.push_back(points_w[k]);
       far_obs.push_back(obs[k]);
-      far_rejected += joint_outlier[k];
     }
   }
   v.near = static_cast<int>(near_idx.size());
   v.far = static_cast<int>(far_points.size());
   if (v.near < cfg.min_points || v.far < cfg.min_points) return v;
-  v.near_joint_outliers = static_cast<double>(near_rejected) / v.near;
-  v.far_joint_outliers = static_cast<double>(far_rejected) / v.far;
-  if (std::max(v.near_joint_outliers, v.far_joint_outliers) < cfg.min_joint_outlier_share) return v;
   v.T_far = T_cw;
   const optim::PoseOptimResult far = optim::optimize_pose(cam, v.T_far, far_points, far_obs, pose);
   v.far_inliers = far.inliers;

@@ -26,9 +26,6 @@ struct NearMoverConfig {
   // ... and the near cluster as a whole misses it: its median chi-square is this many gates (static near points in
   // the real kitchen: median 3, 90th percentile 4; a carried box: median 14).
   double min_median_chi2 = 6.0;
-  // The joint solution must show the conflict too: this share of the near or of the far matches are its outliers
-  // (a static near cluster fits the joint pose; a moving one cannot share a pose with the room).
-  double min_joint_outlier_share = 0.0;
 };
 
 struct NearMoverVerdict {
@@ -37,17 +34,16 @@ struct NearMoverVerdict {
   Eigen::Isometry3d T_far = Eigen::Isometry3d::Identity();  // pose solved on the far cluster (split only)
   std::vector<bool> mover;  // per observation: near and not fitting T_far (moving only)
   int near = 0, far = 0, far_inliers = 0, moving_points = 0;
-  double near_joint_outliers = 0, far_joint_outliers = 0;  // shares rejected by the joint solve
   double near_median_chi2 = 0;  // median near chi-square at T_far, over the plain gate
   double near_depth = 0, far_depth = 0, split_depth = 0;  // metres: cluster centres and the boundary
 };
 
-/// Tests the matches (points_w[k] observed as obs[k]) of a frame solved at T_cw, where joint_outlier[k] says which
-/// that solve rejected. pose: how to solve the far cluster's pose (the tracking settings).
+/// Tests the matches (points_w[k] observed as obs[k]) of a frame solved at T_cw. pose: how to solve the far
+/// cluster's pose (the tracking settings).
 NearMoverVerdict check_near_mover(const PinholeCamera& cam, const Eigen::Isometry3d& T_cw,
                                   const std::vector<Eigen::Vector3d>& points_w,
-                                  const std::vector<optim::Observation>& obs, const std::vector<bool>& joint_outlier,
-                                  const optim::PoseOptimConfig& pose, const NearMoverConfig& cfg);
+                                  const std::vector<optim::Observation>& obs, const optim::PoseOptimConfig& pose,
+                                  const NearMoverConfig& cfg);
 
 /// Two-means on log depth: the boundary between the near and the far cluster and the two centres (metres); false
 /// when there are fewer than two distinct depths. Exposed for tests.

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <limits>
 #include <mutex>
 #include <shared_mutex>
 #include <utility>
@@ -259,12 +258,12 @@ int Tracker::optimize_and_discard(Frame& cur, FrameTimings& t) {
 void Tracker::drop_near_mover(Frame& cur, const FramePoseProblem& p, const optim::PoseOptimConfig& pc,
                               const std::vector<bool>* young, optim::PoseOptimResult& res) {
   const NearMoverVerdict v =
-      check_near_mover(camera_, cur.T_cw, p.points, p.observations, res.outlier, pc, cfg_.tracking.near_mover);
+      check_near_mover(camera_, cur.T_cw, p.points, p.observations, pc, cfg_.tracking.near_mover);
   if (!v.moving) {
     if (!v.split)
       spdlog::trace("frame {}: no near-mover test ({} near at {:.2f} m, {} far at {:.2f} m, {} far inliers)", cur.id,
                     v.near, v.near_depth, v.far, v.far_depth, v.far_inliers);
-    if (v.split)
+    else
       spdlog::trace("frame {}: near cluster kept ({} of {} near at {:.2f} m off, median chi2 {:.1f} gates; {} far at "
                     "{:.2f} m)",
                     cur.id, v.moving_points, v.near, v.near_depth, v.near_median_chi2, v.far, v.far_depth);
@@ -289,10 +288,9 @@ void Tracker::drop_near_mover(Frame& cur, const FramePoseProblem& p, const optim
   for (std::size_t j = 0; j < kept.size(); ++j) res.outlier[kept[j]] = kept_res.outlier[j];
   res.inliers = kept_res.inliers;
   ++near_mover_frames_;
-  spdlog::debug("frame {}: near mover ({} of {} near matches at {:.2f} m move against {} far at {:.2f} m; joint "
-                "outliers near {:.2f} far {:.2f}; near median chi2 {:.1f} gates)",
-                cur.id, v.moving_points, v.near, v.near_depth, v.far, v.far_depth, v.near_joint_outliers,
-                v.far_joint_outliers, v.near_median_chi2);
+  spdlog::debug("frame {}: near mover ({} of {} near matches at {:.2f} m move against {} far at {:.2f} m; near "
+                "median chi2 {:.1f} gates)",
+                cur.id, v.moving_points, v.near, v.near_depth, v.far, v.far_depth, v.near_median_chi2);
   const FrameFeatures& F = *cur.features;
   Eigen::AlignedBox2f region;
   std::vector<float> depths;

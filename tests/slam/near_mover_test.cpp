@@ -80,8 +80,7 @@ TEST(NearMover, ABoxThatMovedIsFoundAndTheWallGivesThePose) {
   // Tracking followed the box: the joint pose is off by about the box's motion.
   Eigen::Isometry3d dragged = T_true;
   dragged.translation() -= T_true.rotation() * Eigen::Vector3d(0.05, 0, 0);
-  const std::vector<bool> joint_outlier(s.points_w.size(), false);
-  const NearMoverVerdict v = check_near_mover(cam, dragged, s.points_w, s.obs, joint_outlier, pose_config(), {});
+  const NearMoverVerdict v = check_near_mover(cam, dragged, s.points_w, s.obs, pose_config(), {});
   ASSERT_TRUE(v.split);
   ASSERT_TRUE(v.moving);
   EXPECT_EQ(v.near, 200);
@@ -97,8 +96,7 @@ TEST(NearMover, AStaticBoxInFrontOfTheWallIsKept) {
   const PinholeCamera cam;
   const Eigen::Isometry3d T_true = camera_pose();
   const Scene s = make_scene(cam, T_true, 120, 200, Eigen::Vector3d::Zero(), 1.0);
-  const std::vector<bool> joint_outlier(s.points_w.size(), false);
-  const NearMoverVerdict v = check_near_mover(cam, T_true, s.points_w, s.obs, joint_outlier, pose_config(), {});
+  const NearMoverVerdict v = check_near_mover(cam, T_true, s.points_w, s.obs, pose_config(), {});
   EXPECT_TRUE(v.split);
   EXPECT_FALSE(v.moving);
   EXPECT_TRUE(v.mover.empty());
@@ -107,13 +105,12 @@ TEST(NearMover, AStaticBoxInFrontOfTheWallIsKept) {
 TEST(NearMover, NothingToDecideWithoutTwoClustersOrWithTooFewFarPoints) {
   const PinholeCamera cam;
   const Eigen::Isometry3d T_true = camera_pose();
-  const std::vector<bool> none(400, false);
   // Only the wall.
   const Scene wall = make_scene(cam, T_true, 300, 0, Eigen::Vector3d::Zero(), 0.5);
-  EXPECT_FALSE(check_near_mover(cam, T_true, wall.points_w, wall.obs, none, pose_config(), {}).moving);
+  EXPECT_FALSE(check_near_mover(cam, T_true, wall.points_w, wall.obs, pose_config(), {}).moving);
   // A moved box hiding all but 10 wall points: too few to speak for the room.
   const Scene hidden = make_scene(cam, T_true, 10, 200, Eigen::Vector3d(0.06, 0, 0), 0.5);
-  const NearMoverVerdict v = check_near_mover(cam, T_true, hidden.points_w, hidden.obs, none, pose_config(), {});
+  const NearMoverVerdict v = check_near_mover(cam, T_true, hidden.points_w, hidden.obs, pose_config(), {});
   EXPECT_FALSE(v.split);
   EXPECT_FALSE(v.moving);
 }
