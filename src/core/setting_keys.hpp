@@ -131,6 +131,8 @@ inline constexpr KeySpec kKeys[] = {
     detail::flag("tracking.near_mover_check", true, "solve the pose on the far matches alone when the near ones (a mover close to the camera) move against them"),
     detail::real("tracking.near_mover_depth_ratio", 1.6, 1.0, 100.0, "the near-mover check splits matches by depth when the far cluster is this much deeper than the near one"),
     detail::real("tracking.near_mover_share", 0.3, 0.0, 1.0, "share of the near matches that must not fit the far pose for the near cluster to count as a mover"),
+    detail::integer("tracking.near_mover_min_points", 30, 3, 100000, "matches each depth cluster needs before the near-mover check tests them"),
+    detail::integer("tracking.near_mover_memory", 30, 0, 1000000, "frames a mover found by the near-mover check is followed after it last moved: its matches are left out of the first pose solve and its keypoints build no points (0 = not followed)"),
     detail::integer("tracking.min_inliers", 30, 3, 100000, "inliers after local-map tracking for a frame to count as tracked"),
     detail::integer("tracking.max_local_keyframes", 80, 1, 100000, "keyframes of the local map a frame is tracked against"),
     detail::integer("tracking.lost_frames_before_reinit", 3, 1, 1000000, "failed recoveries before a new map segment starts"),

@@ -81,6 +81,8 @@ SlamConfig slam_config_from(const Settings& s) {
   t.near_mover_check = setting<bool>(s, "tracking.near_mover_check");
   t.near_mover.min_depth_ratio = setting<double>(s, "tracking.near_mover_depth_ratio");
   t.near_mover.min_moving_share = setting<double>(s, "tracking.near_mover_share");
+  t.near_mover.min_points = setting<int>(s, "tracking.near_mover_min_points");
+  t.mover_track.memory = setting<int>(s, "tracking.near_mover_memory");
   t.min_inliers_local_map = setting<int>(s, "tracking.min_inliers");
   t.max_local_keyframes = setting<int>(s, "tracking.max_local_keyframes");
   t.depth_edge_ratio = setting<double>(s, "depth.edge_ratio");

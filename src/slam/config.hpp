@@ -11,6 +11,7 @@
 #include "optim/kernel.hpp"
 #include "optim/local_ba.hpp"
 #include "optim/pose_optimizer.hpp"
+#include "slam/mover_track.hpp"
 #include "slam/near_mover.hpp"
 
 namespace varslam::slam {
@@ -50,8 +51,11 @@ struct TrackingConfig {
   int established_found = setting_keys::int_default("tracking.established_found");
   int established_age = setting_keys::int_default("tracking.established_age");
   bool near_mover_check = setting_keys::bool_default("tracking.near_mover_check");
-  NearMoverConfig near_mover{.min_depth_ratio = setting_keys::real_default("tracking.near_mover_depth_ratio"),
-                             .min_moving_share = setting_keys::real_default("tracking.near_mover_share")};
+  NearMoverConfig near_mover{
+      .min_depth_ratio = setting_keys::real_default("tracking.near_mover_depth_ratio"),
+      .min_points = setting_keys::int_default("tracking.near_mover_min_points"),
+      .min_moving_share = setting_keys::real_default("tracking.near_mover_share")};
+  MoverTrackConfig mover_track{.memory = setting_keys::int_default("tracking.near_mover_memory")};
   int min_inliers_local_map = setting_keys::int_default("tracking.min_inliers");
   int max_local_keyframes = setting_keys::int_default("tracking.max_local_keyframes");
   int lost_frames_before_reinit = setting_keys::int_default("tracking.lost_frames_before_reinit");

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <mutex>
 #include <shared_mutex>
 #include <utility>
@@ -31,7 +32,7 @@ constexpr int kMinEstablished = 30;  // established matches needed to solve on t
 
 Tracker::Tracker(const SlamConfig& cfg, const PinholeCamera& camera, double close_depth, Map& map, KeyframeSink& sink)
     : cfg_(cfg), camera_(camera), close_depth_(close_depth), map_(map), sink_(sink),
-      extractor_(make_extractor(cfg.orb, cfg.extractor)) {
+      extractor_(make_extractor(cfg.orb, cfg.extractor)), mover_track_(cfg.tracking.mover_track) {
   auto s = std::make_shared<ScaleInfo>();
   s->n_levels = extractor_->n_levels();
   s->scale_factor = extractor_->scale_factor();
@@ -102,10 +103,10 @@ TrackOutcome Tracker::track(const RgbdFrame& input) {
 
   bool ok = false;
   if (state_ == TrackState::Ok) {
-    refresh_last_frame();
+    refresh_last_frame(cur.id);
     ok = track_initial_pose(cur, out.timings);
   } else {
-    refresh_last_frame();
+    refresh_last_frame(cur.id);
     ok = recover(cur, out.timings);
   }
   if (ok) ok = track_local_map(cur, out.timings);
@@ -188,7 +189,7 @@ bool Tracker::initialize(Frame& cur, const Eigen::Isometry3d& T_cw) {
   return true;
 }
 
-void Tracker::refresh_last_frame() {
+void Tracker::refresh_last_frame(long frame_id) {
   // The reference keyframe may have moved (Local BA): re-anchor the last pose to it. A keyframe frame keeps
   // its own pose unless a loop correction moved the map (re-anchoring it after every Local BA measured worse:
   // BENCHMARKS.md, "Why the defaults are what they are").
@@ -208,7 +209,9 @@ void Tracker::refresh_last_frame() {
   int n = 0;
   for (const auto& [d, i] : by_depth) {
     const MapPointPtr& mp = last_.map_points[i];
-    if (last_.on_mover[i]) continue;
+    // Depth points on a followed mover are made too: matched in this frame they are suspects, solved last, and
+    // those that miss the pose are the evidence that the mover still moves.
+    if (last_.on_mover[i] && !mover_track_.active(frame_id)) continue;
     if (!mp || mp->num_observations() < 1) {
       auto tmp = std::make_shared<MapPoint>(-1, T_wc * L.unproject(i), nullptr);
       tmp->set_descriptor(L.descriptors.row(i));
@@ -229,21 +232,25 @@ int Tracker::optimize_and_discard(Frame& cur, FrameTimings& t) {
   // frames, the first round solves on those alone and the others (temporary depth points, young map points) join
   // only where they agree with that pose. A mover entering the view brings many young points that agree with
   // each other (its own motion); solved on all at once, they can outvote the map.
+  const std::vector<bool> suspect = mover_suspects(cur, p);
   std::vector<bool> young(idx.size(), false);
   int established = 0;
   for (std::size_t k = 0; k < idx.size(); ++k) {
     young[k] = !cur.map_points[idx[k]]->is_established(cur.id, cfg_.tracking.established_found,
                                                         cfg_.tracking.established_age);
-    established += !young[k];
+    established += !young[k] && (suspect.empty() || !suspect[k]);
   }
   const bool trust_established = cfg_.tracking.established_found > 0 && established >= kMinEstablished;
+
   optim::PoseOptimConfig pc;
   pc.kernel = cfg_.tracking.kernel;
   // The dedicated 6-DoF solver gives the same pose as Ceres (tested against it) at 1.5-2x less cost.
   pc.solver = optim::PoseSolver::Dedicated;
   pc.observer = cfg_.tracking.pose_observer;
-  auto res =
-      optim::optimize_pose(camera_, cur.T_cw, p.points, p.observations, pc, trust_established ? &young : nullptr);
+  auto res = suspect.empty() ? optim::optimize_pose(camera_, cur.T_cw, p.points, p.observations, pc,
+                                                    trust_established ? &young : nullptr)
+                             : solve_without_suspects(cur, p, pc, suspect, trust_established ? &young : nullptr);
+  if (!suspect.empty()) follow_mover(cur, p, suspect, res);
   if (cfg_.tracking.near_mover_check) drop_near_mover(cur, p, pc, trust_established ? &young : nullptr, res);
   cur.has_pose = true;
   int inliers = 0;
@@ -257,8 +264,7 @@ int Tracker::optimize_and_discard(Frame& cur, FrameTimings& t) {
 
 void Tracker::drop_near_mover(Frame& cur, const FramePoseProblem& p, const optim::PoseOptimConfig& pc,
                               const std::vector<bool>* young, optim::PoseOptimResult& res) {
-  const NearMoverVerdict v =
-      check_near_mover(camera_, cur.T_cw, p.points, p.observations, pc, cfg_.tracking.near_mover);
+  const NearMoverVerdict v = check_near_mover(camera_, cur.T_cw, p.points, p.observations, pc, cfg_.tracking.near_mover);
   if (!v.moving) {
     if (!v.split)
       spdlog::trace("frame {}: no near-mover test ({} near at {:.2f} m, {} far at {:.2f} m, {} far inliers)", cur.id,
@@ -292,7 +298,7 @@ void Tracker::drop_near_mover(Frame& cur, const FramePoseProblem& p, const optim
                 "median chi2 {:.1f} gates)",
                 cur.id, v.moving_points, v.near, v.near_depth, v.far, v.far_depth, v.near_median_chi2);
   const FrameFeatures& F = *cur.features;
-  Eigen::AlignedBox2f region;
+  std::vector<int> near_keypoints;
   std::vector<float> depths;
   for (std::size_t k = 0; k < p.points.size(); ++k) {
     if (!v.mover[k]) continue;
@@ -300,19 +306,113 @@ void Tracker::drop_near_mover(Frame& cur, const FramePoseProblem& p, const optim
     cur.on_mover[i] = true;
     const MapPointPtr& mp = cur.map_points[i];
     if (mp->num_observations() > 0) mp->mark_moving();
-    region.extend(Eigen::Vector2f(F.keypoints[i].pt.x, F.keypoints[i].pt.y));
-    if (F.has_depth(i)) depths.push_back(F.depth[i]);
+    // The mover's extent from the keypoints whose own depth is near too: a near point matched to a keypoint of the
+    // room would stretch the depth band over the room.
+    if (!F.has_depth(i) || F.depth[i] >= v.split_depth) continue;
+    near_keypoints.push_back(i);
+    depths.push_back(F.depth[i]);
   }
   if (depths.empty()) return;
-  const auto [near, far] = std::minmax_element(depths.begin(), depths.end());
-  // Unmatched keypoints on the mover too: inside its image region and depth range (with a margin), as the person
+  // Unmatched keypoints on the mover too: inside its image region and depth band (with a margin), as the person
   // filter does with a detector's box.
-  constexpr float kMarginPx = 10.0f, kDepthMargin = 0.15f;
-  region.min().array() -= kMarginPx;
-  region.max().array() += kMarginPx;
+  const auto [near, far] = mover_depth_band(depths);
+  mover_track_.confirm(cur.id, Eigen::AlignedBox2f(), near, far);
+  Eigen::AlignedBox2f region;
+  for (int i : near_keypoints)
+    if (mover_track_.in_band(F.depth[i])) region.extend(Eigen::Vector2f(F.keypoints[i].pt.x, F.keypoints[i].pt.y));
+  mover_track_.confirm(cur.id, region, near, far);
+  mark_mover_keypoints(cur);
+}
+
+optim::PoseOptimResult Tracker::solve_without_suspects(Frame& cur, const FramePoseProblem& p,
+                                                      const optim::PoseOptimConfig& pc, const std::vector<bool>& suspect,
+                                                      const std::vector<bool>* young) const {
+  // The suspects never pull: a carried box moves almost with the camera, so its points miss the room's pose by a
+  // few pixels only, and once let back in at the plain gate they drag the pose a little every frame.
+  std::vector<Eigen::Vector3d> points;
+  std::vector<optim::Observation> obs;
+  std::vector<bool> kept_young;
+  std::vector<std::size_t> kept;
+  for (std::size_t k = 0; k < suspect.size(); ++k) {
+    if (suspect[k]) continue;
+    kept.push_back(k);
+    points.push_back(p.points[k]);
+    obs.push_back(p.observations[k]);
+    if (young) kept_young.push_back((*young)[k]);
+  }
+  const optim::PoseOptimResult kept_res =
+      optim::optimize_pose(camera_, cur.T_cw, points, obs, pc, young ? &kept_young : nullptr);
+  optim::PoseOptimResult res = kept_res;
+  res.outlier.assign(suspect.size(), true);
+  for (std::size_t j = 0; j < kept.size(); ++j) res.outlier[kept[j]] = kept_res.outlier[j];
+  // A suspect that fits the room's pose is kept as a match (a box held still), without having pulled.
+  for (std::size_t k = 0; k < suspect.size(); ++k) {
+    if (!suspect[k]) continue;
+    const Eigen::Vector3d p_c = cur.T_cw * p.points[k];
+    int dof = 0;
+    res.outlier[k] =
+        p_c.z() <= 0 || optim::whitened_chi2(camera_, p.observations[k], p_c, dof) > optim::chi2_threshold(dof);
+    res.inliers += !res.outlier[k];
+  }
+  return res;
+}
+
+std::vector<bool> Tracker::mover_suspects(const Frame& cur, const FramePoseProblem& p) const {
+  if (!mover_track_.active(cur.id)) return {};
+  const FrameFeatures& F = *cur.features;
+  std::vector<bool> suspect(p.keypoints.size(), false);
+  int n = 0;
+  for (std::size_t k = 0; k < p.keypoints.size(); ++k) {
+    const int i = p.keypoints[k];
+    suspect[k] = F.has_depth(i) && mover_track_.suspect({F.keypoints[i].pt.x, F.keypoints[i].pt.y}, F.depth[i]);
+    n += suspect[k];
+  }
+  if (n == 0) return {};
+  return suspect;
+}
+
+void Tracker::follow_mover(Frame& cur, const FramePoseProblem& p, const std::vector<bool>& suspect,
+                           const optim::PoseOptimResult& res) {
+  const FrameFeatures& F = *cur.features;
+  std::vector<float> depths;
+  int suspects = 0;
+  for (std::size_t k = 0; k < suspect.size(); ++k) {
+    if (!suspect[k]) continue;
+    ++suspects;
+    if (res.outlier[k]) depths.push_back(F.depth[p.keypoints[k]]);
+  }
+  const int missing = static_cast<int>(depths.size());
+  const bool moves = missing >= mover_track_.config().min_confirming &&
+                     missing >= cfg_.tracking.near_mover.min_moving_share * suspects;
+  if (moves) {
+    // Its region: every keypoint at the mover's depth where it may be now, matched or not (the matches of one
+    // solve, against a keyframe say, cover part of it only; a region shrunk to them lets the rest into the map).
+    const auto [near, far] = mover_depth_band(depths);
+    MoverTrack searched = mover_track_;
+    searched.confirm(cur.id, mover_track_.region(), near, far);
+    Eigen::AlignedBox2f region;
+    for (std::size_t i = 0; i < F.size(); ++i)
+      if (F.has_depth(i) && searched.suspect({F.keypoints[i].pt.x, F.keypoints[i].pt.y}, F.depth[i]))
+        region.extend(Eigen::Vector2f(F.keypoints[i].pt.x, F.keypoints[i].pt.y));
+    mover_track_.confirm(cur.id, region, near, far);
+    for (std::size_t k = 0; k < suspect.size(); ++k) {
+      if (!suspect[k] || !res.outlier[k]) continue;
+      const MapPointPtr& mp = cur.map_points[p.keypoints[k]];
+      if (mp->num_observations() > 0) mp->mark_moving();
+    }
+  }
+  spdlog::debug("frame {}: followed mover: {} of {} suspects miss the pose{} (region {:.0f},{:.0f}-{:.0f},{:.0f}, "
+                "{:.2f}-{:.2f} m)",
+                cur.id, missing, suspects, moves ? " (still moving)" : "", mover_track_.region().min().x(),
+                mover_track_.region().min().y(), mover_track_.region().max().x(), mover_track_.region().max().y(),
+                mover_track_.near_depth(), mover_track_.far_depth());
+  mark_mover_keypoints(cur);
+}
+
+void Tracker::mark_mover_keypoints(Frame& cur) const {
+  const FrameFeatures& F = *cur.features;
   for (std::size_t i = 0; i < F.size(); ++i)
-    if (F.has_depth(i) && F.depth[i] >= (1 - kDepthMargin) * *near && F.depth[i] <= (1 + kDepthMargin) * *far &&
-        region.contains(Eigen::Vector2f(F.keypoints[i].pt.x, F.keypoints[i].pt.y)))
+    if (F.has_depth(i) && mover_track_.on_mover({F.keypoints[i].pt.x, F.keypoints[i].pt.y}, F.depth[i]))
       cur.on_mover[i] = true;
 }
 

@@ -109,7 +109,7 @@ class Tracker {
  private:
   Frame build_frame(const RgbdFrame& input, FrameTimings& t);
   bool initialize(Frame& cur, const Eigen::Isometry3d& T_cw);
-  void refresh_last_frame();
+  void refresh_last_frame(long frame_id);
   static void record_fates(const Frame& cur, TrackOutcome& out);
   /// Motion model, falling back to (or cross-checked by) the reference keyframe; true when tracked.
   bool track_initial_pose(Frame& cur, FrameTimings& t);
@@ -125,6 +125,17 @@ class Tracker {
   /// ones, solves again without them and marks them (and the keypoints on the mover) so nothing is built on them.
   void drop_near_mover(Frame& cur, const FramePoseProblem& p, const optim::PoseOptimConfig& pc,
                        const std::vector<bool>* young, optim::PoseOptimResult& res);
+  /// Solves cur.T_cw on the matches that are not suspects; the suspects are then tested at that pose.
+  optim::PoseOptimResult solve_without_suspects(Frame& cur, const FramePoseProblem& p, const optim::PoseOptimConfig& pc,
+                                                const std::vector<bool>& suspect, const std::vector<bool>* young) const;
+  /// The matches of `p` that may lie on the mover being followed; empty when none is followed.
+  std::vector<bool> mover_suspects(const Frame& cur, const FramePoseProblem& p) const;
+  /// After a pose solve that left the suspects out first: those that miss the pose confirm the mover (it moves on,
+  /// its points are marked moving) and carry its region along; the keypoints on it build nothing.
+  void follow_mover(Frame& cur, const FramePoseProblem& p, const std::vector<bool>& suspect,
+                    const optim::PoseOptimResult& res);
+  /// Marks the keypoints the followed mover covers (cur.on_mover): no map point or depth point is made on them.
+  void mark_mover_keypoints(Frame& cur) const;
   void update_local_map(Frame& cur);
   bool need_keyframe(const Frame& cur, int inliers) const;
   void create_keyframe(Frame& cur);
@@ -159,6 +170,7 @@ class Tracker {
   bool localization_only_ = false;
   int relocalizations_ = 0;
   long near_mover_frames_ = 0;
+  MoverTrack mover_track_;  // the near mover being followed (slam/mover_track.hpp)
   std::optional<Relocalization> relocalized_;  // of the frame being tracked, moved into its TrackOutcome
   long seen_corrections_ = 0;  // map_.corrections() when the last frame was last re-anchored
   std::vector<KeyFramePtr> local_keyframes_;
