@@ -276,22 +276,10 @@ void Tracker::drop_near_mover(Frame& cur, const FramePoseProblem& p, const optim
     return;
   }
   // Solve again on everything but the mover, from the far cluster's pose.
-  std::vector<Eigen::Vector3d> points;
-  std::vector<optim::Observation> obs;
-  std::vector<bool> kept_young;
-  std::vector<std::size_t> kept;
-  for (std::size_t k = 0; k < p.points.size(); ++k) {
-    if (v.mover[k]) continue;
-    kept.push_back(k);
-    points.push_back(p.points[k]);
-    obs.push_back(p.observations[k]);
-    if (young) kept_young.push_back((*young)[k]);
-  }
   Eigen::Isometry3d T = v.T_far;
-  const optim::PoseOptimResult kept_res = optim::optimize_pose(camera_, T, points, obs, pc, young ? &kept_young : nullptr);
+  const optim::PoseOptimResult kept_res = solve_leaving_out(T, p, pc, v.mover, young);
   cur.T_cw = T;
-  res.outlier.assign(p.points.size(), true);
-  for (std::size_t j = 0; j < kept.size(); ++j) res.outlier[kept[j]] = kept_res.outlier[j];
+  res.outlier = kept_res.outlier;
   res.inliers = kept_res.inliers;
   ++near_mover_frames_;
   spdlog::debug("frame {}: near mover ({} of {} near matches at {:.2f} m move against {} far at {:.2f} m; near "
@@ -324,27 +312,33 @@ void Tracker::drop_near_mover(Frame& cur, const FramePoseProblem& p, const optim
   mark_mover_keypoints(cur);
 }
 
-optim::PoseOptimResult Tracker::solve_without_suspects(Frame& cur, const FramePoseProblem& p,
-                                                      const optim::PoseOptimConfig& pc, const std::vector<bool>& suspect,
-                                                      const std::vector<bool>* young) const {
-  // The suspects never pull: a carried box moves almost with the camera, so its points miss the room's pose by a
-  // few pixels only, and once let back in at the plain gate they drag the pose a little every frame.
+optim::PoseOptimResult Tracker::solve_leaving_out(Eigen::Isometry3d& T_cw, const FramePoseProblem& p,
+                                                 const optim::PoseOptimConfig& pc, const std::vector<bool>& left_out,
+                                                 const std::vector<bool>* young) const {
   std::vector<Eigen::Vector3d> points;
   std::vector<optim::Observation> obs;
   std::vector<bool> kept_young;
   std::vector<std::size_t> kept;
-  for (std::size_t k = 0; k < suspect.size(); ++k) {
-    if (suspect[k]) continue;
+  for (std::size_t k = 0; k < left_out.size(); ++k) {
+    if (left_out[k]) continue;
     kept.push_back(k);
     points.push_back(p.points[k]);
     obs.push_back(p.observations[k]);
     if (young) kept_young.push_back((*young)[k]);
   }
-  const optim::PoseOptimResult kept_res =
-      optim::optimize_pose(camera_, cur.T_cw, points, obs, pc, young ? &kept_young : nullptr);
-  optim::PoseOptimResult res = kept_res;
-  res.outlier.assign(suspect.size(), true);
-  for (std::size_t j = 0; j < kept.size(); ++j) res.outlier[kept[j]] = kept_res.outlier[j];
+  optim::PoseOptimResult res = optim::optimize_pose(camera_, T_cw, points, obs, pc, young ? &kept_young : nullptr);
+  std::vector<bool> outlier(left_out.size(), true);
+  for (std::size_t j = 0; j < kept.size(); ++j) outlier[kept[j]] = res.outlier[j];
+  res.outlier = std::move(outlier);
+  return res;
+}
+
+optim::PoseOptimResult Tracker::solve_without_suspects(Frame& cur, const FramePoseProblem& p,
+                                                      const optim::PoseOptimConfig& pc, const std::vector<bool>& suspect,
+                                                      const std::vector<bool>* young) const {
+  // The suspects never pull: a carried box moves almost with the camera, so its points miss the room's pose by a
+  // few pixels only, and once let back in at the plain gate they drag the pose a little every frame.
+  optim::PoseOptimResult res = solve_leaving_out(cur.T_cw, p, pc, suspect, young);
   // A suspect that fits the room's pose is kept as a match (a box held still), without having pulled.
   for (std::size_t k = 0; k < suspect.size(); ++k) {
     if (!suspect[k]) continue;

@@ -125,6 +125,10 @@ class Tracker {
   /// ones, solves again without them and marks them (and the keypoints on the mover) so nothing is built on them.
   void drop_near_mover(Frame& cur, const FramePoseProblem& p, const optim::PoseOptimConfig& pc,
                        const std::vector<bool>* young, optim::PoseOptimResult& res);
+  /// Solves T_cw on the matches of `p` not `left_out`; the result is per match of `p`, the left-out ones outliers.
+  optim::PoseOptimResult solve_leaving_out(Eigen::Isometry3d& T_cw, const FramePoseProblem& p,
+                                           const optim::PoseOptimConfig& pc, const std::vector<bool>& left_out,
+                                           const std::vector<bool>* young) const;
   /// Solves cur.T_cw on the matches that are not suspects; the suspects are then tested at that pose.
   optim::PoseOptimResult solve_without_suspects(Frame& cur, const FramePoseProblem& p, const optim::PoseOptimConfig& pc,
                                                 const std::vector<bool>& suspect, const std::vector<bool>* young) const;
