@@ -7,6 +7,7 @@
 #include <thread>
 
 #include "cli_common.hpp"
+#include "bag/bag_dataset.hpp"
 #include "core/error.hpp"
 #include "commands.hpp"
 #include "io/dataset.hpp"
@@ -53,6 +54,7 @@ std::unique_ptr<viewer::LiveViewer> start_viewer(const Opts& o, const Dataset& d
 void add_run_command(CLI::App& app) {
   struct Opts {
     std::string dataset, settings, out = "out/run", groundtruth, save_map, load_map;
+    bag::BagTopics topics;
     bool realtime = false, pace = false, quiet = false, localization_only = false;
     bool viewer = false, viewer_hold = false, viewer_wait = false;
     std::string viewer_address = "127.0.0.1";
@@ -65,7 +67,14 @@ void add_run_command(CLI::App& app) {
   };
   auto o = std::make_shared<Opts>();
   auto* cmd = app.add_subcommand("run", "Run SLAM on a dataset folder and write trajectory, map and metrics");
-  cmd->add_option("--dataset,-d", o->dataset, "Dataset folder (TUM/Bonn/OpenLORIS layout)")->required();
+  cmd->add_option("--dataset,-d", o->dataset, "Dataset folder (TUM/Bonn/OpenLORIS layout) or a ROS 1 .bag file")
+      ->required();
+  cmd->add_option("--topic-rgb", o->topics.rgb, "Bag input: the colour image topic (default: found by type and name)");
+  cmd->add_option("--topic-depth", o->topics.depth, "Bag input: the depth image topic (default: found by type and name)");
+  cmd->add_option("--topic-info", o->topics.info,
+                  "Bag input: the colour camera's CameraInfo topic (default: the one beside the colour topic)");
+  cmd->add_option("--gt-frame", o->topics.gt_frame,
+                  "Bag input: ground truth is the /tf pose of this child frame (e.g. /kinect in TUM bags)");
   cmd->add_option("--settings,-s", o->settings, "Settings YAML (default: <dataset>/settings.yaml)");
   cmd->add_option("--out,-o", o->out, "Output folder")->capture_default_str();
   cmd->add_option("--groundtruth", o->groundtruth, "Ground truth TUM file (default: <dataset>/groundtruth.txt)");
@@ -102,9 +111,15 @@ void add_run_command(CLI::App& app) {
   cmd->callback([o] {
     std::optional<std::filesystem::path> sfile;
     if (!o->settings.empty()) sfile = o->settings;
-    Settings settings = settings_for_dataset(o->dataset, sfile);
+    const bool bag = bag::is_bag_path(o->dataset);
+    const bag::BagTopics& t = o->topics;
+    if (!bag && !(t.rgb.empty() && t.depth.empty() && t.info.empty() && t.gt_frame.empty()))
+      throw InputError(fmt::format("--topic-rgb, --topic-depth, --topic-info and --gt-frame are for .bag input; {} is "
+                                   "not a .bag file",
+                                   o->dataset));
+    Settings settings = bag ? bag::settings_for_bag(o->dataset, sfile, t) : settings_for_dataset(o->dataset, sfile);
     apply_setting_overrides(settings, o->overrides);
-    auto dataset = open_dataset(o->dataset, settings);
+    auto dataset = bag ? bag::open_bag_dataset(o->dataset, settings, t) : open_dataset(o->dataset, settings);
     run::RunOptions ro;
     ro.mode = o->realtime ? RunMode::RealTime : RunMode::Deterministic;
     ro.pace = o->pace;

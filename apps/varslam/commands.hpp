@@ -20,5 +20,6 @@ void add_bench_command(CLI::App& app);
 void add_report_command(CLI::App& app);
 void add_settings_command(CLI::App& app);
 void add_view_command(CLI::App& app);
+void add_bag_command(CLI::App& app);
 
 }  // namespace varslam::cli

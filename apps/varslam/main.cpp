@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   varslam::cli::add_report_command(app);
   varslam::cli::add_settings_command(app);
   varslam::cli::add_view_command(app);
+  varslam::cli::add_bag_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -20,6 +20,7 @@ namespace varslam {
 namespace {
 
 namespace fs = std::filesystem;
+using ::testing::AllOf;
 using ::testing::HasSubstr;
 
 const std::string kCli = std::string(VARSLAM_BINARY_DIR) + "/bin/varslam";
@@ -268,6 +269,44 @@ TEST(BadInput, MapOptionsAreCheckedBeforeTheRun) {
   const Outcome missing = cli(run_on(base_sequence(), "missing_map", "--load-map /nonexistent/x.map"));
   EXPECT_EQ(missing.exit_code, 2) << missing.output;
   EXPECT_THAT(missing.output, HasSubstr("/nonexistent/x.map: map file not found"));
+}
+
+// Bags as input (varslam run --dataset FILE.bag): each broken bag is an error naming the bag and what is wrong.
+TEST(BadInput, BadBagsAreNamedErrors) {
+  const fs::path dir = out_dir("bags");
+  fs::create_directories(dir);
+  const fs::path bag = dir / "good.bag";
+  const Outcome made = cli("bag-from-folder -d " + base_sequence().string() + " -o " + bag.string() + " --images png");
+  if (made.output.find("built without ROS bag support") != std::string::npos) GTEST_SKIP() << "no ROS in this build";
+  ASSERT_EQ(made.exit_code, 0) << made.output;
+  const Outcome ok = cli("run -q -d " + bag.string() + " -o " + (dir / "ok").string() + " --gt-frame kinect");
+  EXPECT_EQ(ok.exit_code, 0) << ok.output;
+  EXPECT_THAT(ok.output, AllOf(HasSubstr("camera from CameraInfo /camera/rgb/camera_info"), HasSubstr("ATE")));
+
+  std::ofstream(dir / "text.bag") << "1.0 rgb/1.png\n";
+  const Outcome text = cli("run -q -d " + (dir / "text.bag").string() + " -o " + (dir / "o1").string());
+  EXPECT_EQ(text.exit_code, 2) << text.output;
+  EXPECT_THAT(text.output, HasSubstr("text.bag: not a ROS bag"));
+
+  const std::string bytes = slurp(bag);
+  std::ofstream(dir / "cut.bag", std::ios::binary) << bytes.substr(0, bytes.size() * 2 / 3);
+  const Outcome cut = cli("run -q -d " + (dir / "cut.bag").string() + " -o " + (dir / "o2").string());
+  EXPECT_EQ(cut.exit_code, 2) << cut.output;
+  EXPECT_THAT(cut.output, AllOf(HasSubstr("cut.bag: the bag is"), HasSubstr("not indexed"), HasSubstr("rosbag reindex")));
+
+  const Outcome topic = cli("run -q -d " + bag.string() + " -o " + (dir / "o3").string() + " --topic-rgb /camera/x");
+  EXPECT_EQ(topic.exit_code, 2) << topic.output;
+  EXPECT_THAT(topic.output, AllOf(HasSubstr("--topic-rgb /camera/x is not in the bag"),
+                                  HasSubstr("/camera/rgb/image_color/compressed (sensor_msgs/CompressedImage")));
+
+  const Outcome gt = cli("run -q -d " + bag.string() + " -o " + (dir / "o4").string() + " --gt-frame body");
+  EXPECT_EQ(gt.exit_code, 2) << gt.output;
+  EXPECT_THAT(gt.output, HasSubstr("--gt-frame body: no transform in /tf or /tf_static has child frame 'body'"));
+
+  const Outcome folder = cli(run_on(base_sequence(), "topic_on_folder", "--topic-rgb /camera/rgb/image_color"));
+  EXPECT_EQ(folder.exit_code, 2) << folder.output;
+  EXPECT_THAT(folder.output, HasSubstr("are for .bag input"));
+  fs::remove_all(dir);
 }
 
 TEST(Demo, RunsFromARelativeFolderWithThePersonFilter) {
