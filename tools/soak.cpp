@@ -1,5 +1,5 @@
 // Soak: the same sequence run again and again in one process through the
-// pipeline API (varslam::Slam), as an embedding application would. Per run:
+// pipeline API (varslam::Pipeline), as an embedding application would. Per run:
 // peak and final resident memory, per-frame tracking time (median of the first
 // and last thirds, to see growth), ATE of the final and live trajectories, and
 // a hash of the final trajectory (deterministic mode: every run must give the
@@ -67,7 +67,7 @@ nlohmann::json one_run(const varslam::Dataset& dataset, const varslam::Settings&
   using namespace varslam;
   reset_peak_rss();
   const auto t0 = Clock::now();
-  Slam slam(settings);
+  Pipeline slam(settings);
   std::vector<RgbdFrame> samples;  // as the CLI does: 10 frames spread over the first 300
   if (slam.wants_depth_samples())
     for (std::size_t k = 0; k < 10; ++k)

@@ -1,8 +1,9 @@
 // Minimal varslam user: reads colour and 16-bit depth PNGs of the same names from FOLDER/rgb and FOLDER/depth
 // (file names are the timestamps, e.g. 1311870436.796000.png), runs the full system with the person filter
-// (YOLO when its model is found: set VARSLAM_MODELS) and prints one TUM pose line per tracked frame.
+// (YOLO when its model is found: set VARSLAM_MODELS) and prints one TUM pose line per tracked frame. C++17.
 //   rgbd_folder FOLDER [SETTINGS.yaml]
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <opencv2/imgcodecs.hpp>
@@ -17,8 +18,9 @@ int main(int argc, char** argv) {
   }
   const fs::path folder = argv[1];
   try {
-    varslam::Settings settings = varslam::load_settings(argc > 2 ? fs::path(argv[2]) : folder / "settings.yaml");
-    varslam::Slam slam(settings);  // semantic.detector defaults to auto: YOLO when the model is found
+    const varslam::Config config =
+        varslam::Config::from_file(argc > 2 ? std::string(argv[2]) : (folder / "settings.yaml").string());
+    varslam::Slam slam(config);  // semantic.detector defaults to auto: YOLO when the model is found
     std::vector<fs::path> images;
     for (const auto& e : fs::directory_iterator(folder / "rgb")) images.push_back(e.path());
     std::sort(images.begin(), images.end());
@@ -26,18 +28,18 @@ int main(int argc, char** argv) {
       const cv::Mat bgr = cv::imread(rgb.string(), cv::IMREAD_COLOR);
       const cv::Mat depth = cv::imread((folder / "depth" / rgb.filename()).string(), cv::IMREAD_UNCHANGED);
       const double t = std::stod(rgb.stem().string());
-      const varslam::FrameResult r = slam.track(bgr, depth, t);
-      if (!r.T_wc) continue;
-      const Eigen::Vector3d p = r.T_wc->translation();
-      const Eigen::Quaterniond q(r.T_wc->rotation());
-      std::printf("%.6f %.5f %.5f %.5f %.6f %.6f %.6f %.6f\n", t, p.x(), p.y(), p.z(), q.x(), q.y(), q.z(), q.w());
+      const varslam::TrackedFrame f = slam.track(bgr, depth, t);
+      if (!f.pose) continue;
+      const auto& p = f.pose->translation;
+      const auto& q = f.pose->rotation;  // x y z w
+      std::printf("%.6f %.5f %.5f %.5f %.6f %.6f %.6f %.6f\n", t, p[0], p[1], p[2], q[0], q[1], q[2], q[3]);
     }
     slam.finish();
-    const varslam::SlamSummary s = slam.summary();
+    const varslam::SessionSummary s = slam.summary();
     std::cerr << s.tracked << " of " << s.frames << " frames tracked, " << s.keyframes << " keyframes, person filter: "
-              << s.detector << "\n";
+              << s.person_detector << "\n";
     return s.tracked > 0 ? 0 : 1;
-  } catch (const std::exception& e) {
+  } catch (const varslam::InputError& e) {
     std::cerr << "rgbd_folder: " << e.what() << "\n";
     return 2;
   }

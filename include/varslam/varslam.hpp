@@ -1,6 +1,9 @@
 #pragma once
-// varslam's public API in one include: the pipeline (varslam::Slam), its events, and the settings it reads.
-#include "io/settings.hpp"           // load_settings, default_settings
-#include "io/settings_registry.hpp"  // apply_setting_overrides, setting<T>
-#include "pipeline/events.hpp"       // Observer and the events it receives
-#include "pipeline/slam.hpp"         // varslam::Slam
+// varslam's public API in one include (C++17): the session (varslam::Slam), its settings (varslam::Config), the
+// value types it hands out, its errors and where its log goes. Nothing of Ceres, glog, yaml-cpp, Eigen or the
+// SLAM internals. docs/api.md has a complete example.
+#include <varslam/config.hpp>
+#include <varslam/error.hpp>
+#include <varslam/log.hpp>
+#include <varslam/slam.hpp>
+#include <varslam/types.hpp>

@@ -1,6 +1,6 @@
 #pragma once
 // What the pipeline reports while it runs. Observers receive every event on the thread that calls
-// Slam::track() / Slam::finish() (work done on the mapping thread is queued and handed over there), so an
+// Pipeline::track() / Pipeline::finish() (work done on the mapping thread is queued and handed over there), so an
 // observer needs no locking of its own; one that does slow work (a viewer, a network sender) should copy what it
 // needs and hand it to its own thread.
 #include <Eigen/Geometry>
@@ -19,7 +19,7 @@ namespace varslam {
 
 using slam::TrackState;
 
-/// One frame through tracking: what Slam::track() returns and on_frame() receives.
+/// One frame through tracking: what Pipeline::track() returns and on_frame() receives.
 struct FrameResult {
   std::size_t index = 0;  // frames given to the pipeline before this one
   double timestamp = 0;
@@ -85,14 +85,14 @@ struct DepthRegistrationEvent {
   std::optional<PinholeCamera> colour_camera;  // the colour camera estimated (found)
 };
 
-class Slam;
+class Pipeline;
 
 class Observer {
  public:
   virtual ~Observer() = default;
-  /// From Slam::add_observer: the pipeline now observed (its map and trajectories may be read from a callback).
-  virtual void on_added(const Slam&) {}
-  /// From Slam::finish(), last: the map and trajectories are final.
+  /// From Pipeline::add_observer: the pipeline now observed (its map and trajectories may be read from a callback).
+  virtual void on_added(const Pipeline&) {}
+  /// From Pipeline::finish(), last: the map and trajectories are final.
   virtual void on_finished() {}
   virtual void on_depth_registration(const DepthRegistrationEvent&) {}
   virtual void on_frame(const FrameResult&) {}

@@ -69,13 +69,13 @@ RgbdFrame frame_from_images(const cv::Mat& bgr, const cv::Mat& depth, double tim
   const PinholeCamera& cam = settings.camera;
   const auto check_size = [&](const cv::Mat& m, const char* what) {
     if (m.cols != cam.width || m.rows != cam.height)
-      throw InputError(fmt::format("Slam::track: {} image is {}x{}, the camera is {}x{}", what, m.cols, m.rows,
+      throw InputError(fmt::format("Pipeline::track: {} image is {}x{}, the camera is {}x{}", what, m.cols, m.rows,
                                    cam.width, cam.height));
   };
   RgbdFrame f;
   f.index = index;
   f.timestamp = timestamp;
-  if (bgr.empty()) throw InputError("Slam::track: empty colour image");
+  if (bgr.empty()) throw InputError("Pipeline::track: empty colour image");
   check_size(bgr, "colour");
   if (bgr.type() == CV_8UC3) {
     f.bgr = bgr;
@@ -84,13 +84,13 @@ RgbdFrame frame_from_images(const cv::Mat& bgr, const cv::Mat& depth, double tim
     f.gray = bgr.clone();  // kept for box propagation: must not follow a capture buffer the caller reuses
     cv::cvtColor(bgr, f.bgr, cv::COLOR_GRAY2BGR);
   } else {
-    throw InputError("Slam::track: the colour image must be CV_8UC3 (BGR) or CV_8UC1");
+    throw InputError("Pipeline::track: the colour image must be CV_8UC3 (BGR) or CV_8UC1");
   }
-  if (depth.empty()) throw InputError("Slam::track: empty depth image");
+  if (depth.empty()) throw InputError("Pipeline::track: empty depth image");
   check_size(depth, "depth");
   if (depth.type() == CV_16UC1) f.depth = depth_to_metres(depth, settings.depth_factor);
   else if (depth.type() == CV_32FC1) f.depth = depth;
-  else throw InputError("Slam::track: the depth image must be CV_16UC1 (raw, depth.factor per metre) or CV_32FC1 (m)");
+  else throw InputError("Pipeline::track: the depth image must be CV_16UC1 (raw, depth.factor per metre) or CV_32FC1 (m)");
   return f;
 }
 
@@ -98,10 +98,10 @@ RgbdFrame frame_from_images(const cv::Mat& bgr, const cv::Mat& depth, double tim
 void check_frame(const RgbdFrame& f, const PinholeCamera& cam) {
   const auto fits = [&](const cv::Mat& m) { return m.cols == cam.width && m.rows == cam.height; };
   if (f.gray.empty() || f.gray.type() != CV_8UC1 || !fits(f.gray))
-    throw InputError(fmt::format("Slam::track: frame {} needs a CV_8UC1 gray image of {}x{}", f.index, cam.width,
+    throw InputError(fmt::format("Pipeline::track: frame {} needs a CV_8UC1 gray image of {}x{}", f.index, cam.width,
                                  cam.height));
   if (f.depth.empty() || f.depth.type() != CV_32FC1 || !fits(f.depth))
-    throw InputError(fmt::format("Slam::track: frame {} needs a CV_32FC1 depth image in metres of {}x{}", f.index,
+    throw InputError(fmt::format("Pipeline::track: frame {} needs a CV_32FC1 depth image in metres of {}x{}", f.index,
                                  cam.width, cam.height));
 }
 
@@ -114,7 +114,7 @@ const Settings& checked(const Settings& s) {
 }  // namespace
 
 // Records from the stages, any thread -> a queue the caller's thread empties.
-class Slam::Relay final : public slam::SystemObserver {
+class Pipeline::Relay final : public slam::SystemObserver {
  public:
   using Record = std::variant<slam::KeyframeMapped, slam::LoopSearch, slam::LoopRecord>;
   void on_keyframe_mapped(const slam::KeyframeMapped& r) override { push(r); }
@@ -134,7 +134,7 @@ class Slam::Relay final : public slam::SystemObserver {
   std::vector<Record> queue_;
 };
 
-Slam::Slam(const Settings& settings, SlamOptions options)
+Pipeline::Pipeline(const Settings& settings, PipelineOptions options)
     : settings_(checked(settings)),
       cfg_(slam::slam_config_from(settings)),
       options_(std::move(options)),
@@ -156,29 +156,29 @@ Slam::Slam(const Settings& settings, SlamOptions options)
   }
 }
 
-Slam::~Slam() = default;
+Pipeline::~Pipeline() = default;
 
-void Slam::add_observer(Observer& observer) {
+void Pipeline::add_observer(Observer& observer) {
   observers_.push_back(&observer);
   observer.on_added(*this);
 }
 
-void Slam::remove_observer(Observer& observer) {
+void Pipeline::remove_observer(Observer& observer) {
   observers_.erase(std::remove(observers_.begin(), observers_.end(), &observer), observers_.end());
 }
 
 template <typename Event, typename Fn>
-void Slam::emit(const Event& e, Fn fn) {
+void Pipeline::emit(const Event& e, Fn fn) {
   const std::vector<Observer*> observers = observers_;  // an observer may add or remove observers meanwhile
   for (Observer* o : observers) (o->*fn)(e);
 }
 
-void Slam::calibrate_depth(std::span<const RgbdFrame> samples) {
-  if (system_) throw std::logic_error("Slam::calibrate_depth: call it before the first frame");
+void Pipeline::calibrate_depth(std::span<const RgbdFrame> samples) {
+  if (system_) throw std::logic_error("Pipeline::calibrate_depth: call it before the first frame");
   start(samples);
 }
 
-void Slam::start(std::span<const RgbdFrame> samples) {
+void Pipeline::start(std::span<const RgbdFrame> samples) {
   const DepthRegistrationEvent reg = register_depth_if_needed(samples, settings_, cfg_);
   system_ = std::make_unique<slam::System>(cfg_, settings_.camera, settings_.close_depth_m(), options_.mode,
                                            relay_.get());
@@ -193,7 +193,7 @@ void Slam::start(std::span<const RgbdFrame> samples) {
   emit(reg, &Observer::on_depth_registration);
 }
 
-void Slam::install_person_filter() {
+void Pipeline::install_person_filter() {
   system_->set_keypoint_filter([this](const RgbdFrame& f, const std::vector<cv::KeyPoint>& kps) {
     semantic::MaskResult r = masker_->process(f, kps);
     DetectionEvent d;
@@ -217,9 +217,9 @@ void Slam::install_person_filter() {
     system_->set_extraction_mask([this](const RgbdFrame& f) { return masker_->extraction_mask(f); });
 }
 
-std::function<void(RgbdFrame&)> Slam::frame_preparation() const {
+std::function<void(RgbdFrame&)> Pipeline::frame_preparation() const {
   if (!system_ && wants_depth_samples())
-    throw std::logic_error("Slam::frame_preparation: call calibrate_depth() first (depth.registration: auto)");
+    throw std::logic_error("Pipeline::frame_preparation: call calibrate_depth() first (depth.registration: auto)");
   if (!cfg_.tracking.depth_rig) return [](RgbdFrame& f) { f.depth_in_colour_frame = true; };
   return [rig = *cfg_.tracking.depth_rig, colour = settings_.camera](RgbdFrame& f) {
     if (f.depth_in_colour_frame) return;
@@ -228,13 +228,13 @@ std::function<void(RgbdFrame&)> Slam::frame_preparation() const {
   };
 }
 
-FrameResult Slam::track(const cv::Mat& bgr, const cv::Mat& depth, double timestamp,
+FrameResult Pipeline::track(const cv::Mat& bgr, const cv::Mat& depth, double timestamp,
                         const std::optional<Detections>& boxes) {
   return track(frame_from_images(bgr, depth, timestamp, frames_, settings_), boxes);
 }
 
-FrameResult Slam::track(const RgbdFrame& input, const std::optional<Detections>& boxes) {
-  if (finished_) throw std::logic_error("Slam::track after finish()");
+FrameResult Pipeline::track(const RgbdFrame& input, const std::optional<Detections>& boxes) {
+  if (finished_) throw std::logic_error("Pipeline::track after finish()");
   check_frame(input, settings_.camera);
   if (!system_) start(std::span<const RgbdFrame>(&input, 1));
   RgbdFrame frame = input;
@@ -286,7 +286,7 @@ FrameResult Slam::track(const RgbdFrame& input, const std::optional<Detections>&
   return r;
 }
 
-void Slam::deliver_queued() {
+void Pipeline::deliver_queued() {
   for (const Relay::Record& rec : relay_->take()) {
     if (const auto* m = std::get_if<slam::KeyframeMapped>(&rec)) emit(*m, &Observer::on_keyframe_mapped);
     else if (const auto* s = std::get_if<slam::LoopSearch>(&rec)) emit(*s, &Observer::on_loop_search);
@@ -294,7 +294,7 @@ void Slam::deliver_queued() {
   }
 }
 
-void Slam::finish() {
+void Pipeline::finish() {
   if (finished_) return;
   finished_ = true;
   try {
@@ -308,8 +308,8 @@ void Slam::finish() {
   for (Observer* o : observers) o->on_finished();
 }
 
-void Slam::load_map(const std::filesystem::path& file) {
-  if (system_) throw std::logic_error("Slam::load_map after the first frame");
+void Pipeline::load_map(const std::filesystem::path& file) {
+  if (system_) throw std::logic_error("Pipeline::load_map after the first frame");
   mapfile::SavedMap m = mapfile::load_map_file(file);
   // The colour camera may still change (depth registration is estimated at start()): intrinsics are checked then,
   // size and pyramid now.
@@ -326,15 +326,14 @@ void Slam::load_map(const std::filesystem::path& file) {
   pending_map_ = std::move(m);
 }
 
-void Slam::set_localization_only(bool on) {
+void Pipeline::set_localization_only(bool on) {
   if (on && !system_ && !pending_map_)
-    throw std::logic_error("Slam::set_localization_only: there is no map to localize in (load_map() first)");
+    throw std::logic_error("Pipeline::set_localization_only: there is no map to localize in (load_map() first)");
   localization_only_ = on;
   if (system_) system_->set_localization_only(on);
 }
 
-void Slam::save_map(const std::filesystem::path& file, const std::optional<Eigen::Isometry3d>& groundtruth_alignment) const {
-  if (!finished_) throw std::logic_error("Slam::save_map before finish()");
+void Pipeline::save_map(const std::filesystem::path& file, const std::optional<Eigen::Isometry3d>& groundtruth_alignment) {
   if (!system_) throw InputError(fmt::format("{}: no map to save (no frame was tracked)", file.string()));
   mapfile::MapFingerprint fp;
   fp.camera = settings_.camera;
@@ -344,23 +343,23 @@ void Slam::save_map(const std::filesystem::path& file, const std::optional<Eigen
   fp.disparity_weight = cfg_.tracking.disparity_weight;
   fp.settings_yaml = settings_yaml(settings_);
   fp.created_by = "varslam " + std::string(kVersion);
-  slam::SavedMap m = system_->snapshot(std::move(fp));
+  slam::SavedMap m = system_->snapshot_now(std::move(fp));
   if (m.keyframes.empty()) throw InputError(fmt::format("{}: no map to save (no keyframe)", file.string()));
   m.groundtruth_alignment = groundtruth_alignment;
   mapfile::save_map_file(m, file);
 }
 
-Trajectory Slam::camera_trajectory(int* repaired) const {
+Trajectory Pipeline::camera_trajectory(int* repaired) const {
   if (repaired) *repaired = 0;
   return system_ ? system_->camera_trajectory(false, repaired) : Trajectory{};
 }
 
-Trajectory Slam::keyframe_trajectory() const { return system_ ? system_->keyframe_trajectory() : Trajectory{}; }
+Trajectory Pipeline::keyframe_trajectory() const { return system_ ? system_->keyframe_trajectory() : Trajectory{}; }
 
-const slam::Map& Slam::map() const { return system_ ? system_->map() : empty_map_; }
+const slam::Map& Pipeline::map() const { return system_ ? system_->map() : empty_map_; }
 
-SlamSummary Slam::summary() const {
-  SlamSummary s;
+PipelineSummary Pipeline::summary() const {
+  PipelineSummary s;
   s.frames = frames_;
   s.tracked = tracked_;
   if (system_) {

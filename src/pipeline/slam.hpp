@@ -1,11 +1,11 @@
 #pragma once
-// varslam::Slam: the whole system of the paper behind one object. Settings -> depth registration -> person
+// varslam::Pipeline: the whole system of the paper behind one object. Settings -> depth registration -> person
 // detector + depth-aware keypoint filter + extraction mask -> tracking -> local mapping -> loop closing, in
 // deterministic mode (every stage in the caller's thread: same input, same output) or real-time mode (local
 // mapping and the detector on their own threads). Feed it colour + depth + timestamp; it returns the pose and
 // reports everything else to observers (pipeline/events.hpp). It never prints (the stages log through spdlog).
 //
-//   varslam::Slam slam(varslam::load_settings("settings.yaml"));
+//   varslam::Pipeline slam(varslam::load_settings("settings.yaml"));
 //   for (...) { const varslam::FrameResult r = slam.track(bgr, depth16, t); if (r.T_wc) use(*r.T_wc); }
 //   slam.finish();
 //   const varslam::Trajectory traj = slam.camera_trajectory();
@@ -36,7 +36,7 @@ namespace semantic {
 class DynamicKeypointMasker;
 }
 
-struct SlamOptions {
+struct PipelineOptions {
   RunMode mode = RunMode::Deterministic;
   /// A person detector of the caller's own, used instead of the one `semantic.detector` names. In real-time mode
   /// with semantic.asynchronous it runs on the detector's thread.
@@ -44,7 +44,7 @@ struct SlamOptions {
 };
 
 /// Facts about the whole run so far (on request).
-struct SlamSummary {
+struct PipelineSummary {
   std::size_t frames = 0, tracked = 0, keyframes = 0, map_points = 0;
   int segments = 0, relocalizations = 0;
   long near_mover_solves = 0;  // pose solves the near-mover check changed (tracking.near_mover_check)
@@ -53,13 +53,13 @@ struct SlamSummary {
   bool detector_asynchronous = false;
 };
 
-class Slam {
+class Pipeline {
  public:
   /// Throws ConfigError for bad settings and InputError when the detector's model cannot be loaded.
-  explicit Slam(const Settings& settings, SlamOptions options = {});
-  ~Slam();  // stops the worker threads (finish() first to keep the map complete)
-  Slam(const Slam&) = delete;
-  Slam& operator=(const Slam&) = delete;
+  explicit Pipeline(const Settings& settings, PipelineOptions options = {});
+  ~Pipeline();  // stops the worker threads (finish() first to keep the map complete)
+  Pipeline(const Pipeline&) = delete;
+  Pipeline& operator=(const Pipeline&) = delete;
 
   /// Observers get every event from now on, in the order added. Not owned: each must outlive the pipeline or be
   /// removed first. An observer may add or remove observers from a callback, but not call track() or finish().
@@ -81,10 +81,11 @@ class Slam {
   /// Track against the map without extending it (no keyframes, no points, no new segment): the live pose in a
   /// known map, as a robot uses it. Needs a loaded map when switched on before the first frame.
   void set_localization_only(bool on);
-  /// After finish(): writes the map (atomically). `groundtruth_alignment` (map frame -> ground-truth frame), when
+  /// Writes the map (atomically): after finish(), or between track() calls (real-time mode: local mapping is
+  /// paused until its queue is drained, then resumed). `groundtruth_alignment` (map frame -> ground-truth frame), when
   /// the caller has one, goes with it so runs in this map can be evaluated in its frame.
   void save_map(const std::filesystem::path& file,
-                const std::optional<Eigen::Isometry3d>& groundtruth_alignment = std::nullopt) const;
+                const std::optional<Eigen::Isometry3d>& groundtruth_alignment = std::nullopt);
   /// The loaded map's alignment to ground truth, when it has one.
   const std::optional<Eigen::Isometry3d>& loaded_map_alignment() const { return loaded_alignment_; }
 
@@ -108,7 +109,7 @@ class Slam {
   const Trajectory& live_trajectory() const { return live_; }
   Trajectory keyframe_trajectory() const;
   const slam::Map& map() const;
-  SlamSummary summary() const;
+  PipelineSummary summary() const;
 
   const Settings& settings() const { return settings_; }  // camera = the colour camera after registration
   const slam::SlamConfig& config() const { return cfg_; }
@@ -124,7 +125,7 @@ class Slam {
 
   Settings settings_;
   slam::SlamConfig cfg_;
-  SlamOptions options_;
+  PipelineOptions options_;
   semantic::SemanticSettings semantic_;
   std::vector<Observer*> observers_;
   std::unique_ptr<Relay> relay_;

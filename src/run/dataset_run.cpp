@@ -191,7 +191,7 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const RunO
   if (gt_path && std::filesystem::exists(*gt_path)) groundtruth = read_tum_trajectory(*gt_path);
 
   const OutputFolder out(out_dir);
-  Slam slam(settings, SlamOptions{options.mode, nullptr});
+  Pipeline slam(settings, PipelineOptions{options.mode, nullptr});
   MetricsRecorder metrics;
   slam.add_observer(metrics);
   std::optional<ProgressLine> progress;
@@ -237,7 +237,7 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const RunO
   RunSummary sum;
   sum.out_dir = out_dir;
   sum.interrupted = interrupted;
-  const SlamSummary s = slam.summary();
+  const PipelineSummary s = slam.summary();
   sum.frames = metrics.frames();
   sum.tracked = metrics.tracked();
   sum.lost = sum.frames - sum.tracked;

@@ -1,7 +1,7 @@
 #pragma once
 // Runs the pipeline over a dataset and writes what a user opens afterwards: TUM trajectories, the map as PLY,
 // metrics.json (with the ATE and RPE when ground truth exists). The dataset loop, pacing and the file writers;
-// everything SLAM is varslam::Slam.
+// everything SLAM is varslam::Pipeline.
 #include <atomic>
 #include <filesystem>
 #include <nlohmann/json.hpp>

@@ -77,8 +77,8 @@ void MetricsRecorder::on_keyframe_mapped(const slam::KeyframeMapped& m) {
                  {"ms", b.ms}});
 }
 
-nlohmann::json MetricsRecorder::metrics(const Slam& slam) const {
-  const SlamSummary s = slam.summary();
+nlohmann::json MetricsRecorder::metrics(const Pipeline& slam) const {
+  const PipelineSummary s = slam.summary();
   nlohmann::json m;
   m["mode"] = slam.mode() == RunMode::Deterministic ? "deterministic" : "realtime";
   m["frames"] = frames();

@@ -25,7 +25,7 @@ class MetricsRecorder final : public Observer {
   void on_loop(const slam::LoopRecord& l) override { loops_.push_back(l); }
 
   /// The metrics of the run so far; `slam` gives the facts kept by the pipeline (map size, segments, kernels).
-  nlohmann::json metrics(const Slam& slam) const;
+  nlohmann::json metrics(const Pipeline& slam) const;
   const std::vector<double>& frame_timestamps() const { return stamps_; }
   std::size_t frames() const { return stamps_.size(); }
   std::size_t tracked() const { return tracked_; }

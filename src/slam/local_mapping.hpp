@@ -35,6 +35,7 @@ class LocalMapper final : public KeyframeSink {
   void start();
   /// Finishes the queued keyframes and joins the thread.
   void stop();
+  bool running() const { return thread_.joinable(); }
 
   /// Receives a KeyframeMapped record per processed keyframe, on the mapping thread. Set before start().
   void set_observer(SystemObserver* observer) { observer_ = observer; }

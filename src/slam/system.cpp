@@ -35,6 +35,15 @@ SavedMap System::snapshot(MapFingerprint fingerprint) const {
   return snapshot_map(map_, places_, std::move(fingerprint), tracker_.next_frame_id());
 }
 
+SavedMap System::snapshot_now(MapFingerprint fingerprint) {
+  const bool pause = mode_ == RunMode::RealTime && mapper_.running();
+  if (pause) mapper_.stop();
+  if (const auto failure = mapper_.failure()) std::rethrow_exception(failure);
+  SavedMap saved = snapshot(std::move(fingerprint));
+  if (pause) mapper_.start();
+  return saved;
+}
+
 TrackOutcome System::process(const RgbdFrame& frame) {
   // After a mapping error the map is no longer consistent: every later call reports that error.
   if (const auto failure = mapper_.failure()) std::rethrow_exception(failure);

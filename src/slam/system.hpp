@@ -36,6 +36,9 @@ class System {
   void adopt_map(const SavedMap& saved);
   /// The map as records, after finish() (real-time mode: mapping must be idle).
   SavedMap snapshot(MapFingerprint fingerprint) const;
+  /// The same while running: in real-time mode local mapping is paused (its queue drained, so the map is
+  /// consistent) for the copy and started again. Call from the thread that calls process().
+  SavedMap snapshot_now(MapFingerprint fingerprint);
   void set_localization_only(bool on) { tracker_.set_localization_only(on); }
 
   void set_keypoint_filter(KeypointFilterFn fn) { tracker_.set_keypoint_filter(std::move(fn)); }

@@ -73,7 +73,7 @@ LiveViewerStats LiveViewer::stats() const {
   return s;
 }
 
-void LiveViewer::on_added(const Slam& slam) { slam_ = &slam; }
+void LiveViewer::on_added(const Pipeline& slam) { slam_ = &slam; }
 
 void LiveViewer::log(std::string_view event, const nlohmann::json& data) {
   {
@@ -210,7 +210,7 @@ void LiveViewer::on_finished() {  // after tracking: not counted as time taken f
     final_map_published_ = true;
   }
   if (slam_) {
-    const SlamSummary s = slam_->summary();
+    const PipelineSummary s = slam_->summary();
     log("done", {{"frames", s.frames},
                  {"tracked", s.tracked},
                  {"keyframes", s.keyframes},

@@ -58,7 +58,7 @@ class LiveViewer : public Observer {
   /// Ends the streams and the threads (the destructor does it too).
   void stop();
 
-  void on_added(const Slam& slam) override;
+  void on_added(const Pipeline& slam) override;
   void on_depth_registration(const DepthRegistrationEvent& e) override;
   void on_detection(const DetectionEvent& e) override;
   void on_keypoints(const KeypointsEvent& e) override;
@@ -95,7 +95,7 @@ class LiveViewer : public Observer {
   LiveViewerOptions options_;
   ViewerBoard board_;
   ViewerServer server_;
-  const Slam* slam_ = nullptr;
+  const Pipeline* slam_ = nullptr;
 
   // Tracking thread only.
   PendingFrame building_;

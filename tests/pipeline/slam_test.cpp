@@ -1,4 +1,4 @@
-// varslam::Slam, the pipeline as a library user drives it: images in, poses and events out.
+// varslam::Pipeline, the pipeline as a library user drives it: images in, poses and events out.
 #include "pipeline/slam.hpp"
 
 #include <gtest/gtest.h>
@@ -95,7 +95,7 @@ TEST(Pipeline, FedImagesGiveTheDatasetRunsTrajectoryAndEveryEvent) {
   const run::RunSummary ref = run::run_slam(*open_dataset(seq, settings), settings, ro, out);
 
   const Images im = read_images(seq, settings, 40);
-  Slam slam(settings);
+  Pipeline slam(settings);
   Tally tally;
   slam.add_observer(tally);
   std::size_t tracked = 0;
@@ -128,7 +128,7 @@ TEST(Pipeline, CallersBoxesSwitchThePersonFilterOn) {
   const Settings settings = settings_without_detector(seq);
   const BoxesByTime boxes = read_boxes_file(seq / "boxes.txt");
   const Images im = read_images(seq, settings, 20);
-  Slam slam(settings);
+  Pipeline slam(settings);
   Tally tally;
   slam.add_observer(tally);
   for (std::size_t i = 0; i < im.bgr.size(); ++i)
@@ -140,7 +140,7 @@ TEST(Pipeline, CallersBoxesSwitchThePersonFilterOn) {
   // The same boxes through the settings' boxes file give the same trajectory.
   Settings with_file = settings;
   apply_setting_overrides(with_file, {"semantic.detector=boxes"});  // the dataset's boxes.txt by default
-  Slam from_file(with_file);
+  Pipeline from_file(with_file);
   for (std::size_t i = 0; i < im.bgr.size(); ++i) from_file.track(im.bgr[i], im.depth[i], im.stamps[i]);
   from_file.finish();
   const fs::path out = out_dir("boxes");
@@ -152,7 +152,7 @@ TEST(Pipeline, CallersBoxesSwitchThePersonFilterOn) {
 TEST(Pipeline, ImagesOfTheWrongSizeOrTypeAreInputErrors) {
   Settings settings = default_settings();
   apply_setting_overrides(settings, {"semantic.detector=none"});
-  Slam slam(settings);
+  Pipeline slam(settings);
   const cv::Mat bgr(480, 640, CV_8UC3, cv::Scalar::all(100)), depth(480, 640, CV_16UC1, cv::Scalar::all(5000));
   EXPECT_THROW(slam.track(cv::Mat(240, 320, CV_8UC3), depth, 0.0), InputError);
   EXPECT_THROW(slam.track(bgr, cv::Mat(480, 640, CV_8UC2), 0.0), InputError);
@@ -166,11 +166,11 @@ TEST(Pipeline, ImagesOfTheWrongSizeOrTypeAreInputErrors) {
 TEST(Pipeline, SettingsBuiltInCodeAreCheckedAndMisuseIsNamed) {
   Settings typo = default_settings();
   typo.root = YAML::Load("tracking: {kernl: huber}");
-  EXPECT_THROW(Slam{typo}, ConfigError);
+  EXPECT_THROW(Pipeline{typo}, ConfigError);
 
   Settings s = default_settings();
   apply_setting_overrides(s, {"semantic.detector=none"});
-  Slam slam(s);
+  Pipeline slam(s);
   EXPECT_THROW(slam.frame_preparation(), std::logic_error);  // depth registration is not decided yet
   slam.calibrate_depth({});
   EXPECT_NO_THROW(slam.frame_preparation());
@@ -195,7 +195,7 @@ TEST(Pipeline, RealTimeEventsArriveOnTheCallersThread) {
     void on_loop_search(const slam::LoopSearch&) override { note(); }
   } check;
   const Images im = read_images(seq, settings, 60);
-  Slam slam(settings, SlamOptions{RunMode::RealTime, nullptr});
+  Pipeline slam(settings, PipelineOptions{RunMode::RealTime, nullptr});
   slam.add_observer(check);
   std::size_t tracked = 0;
   for (std::size_t i = 0; i < im.bgr.size(); ++i) tracked += slam.track(im.bgr[i], im.depth[i], im.stamps[i]).T_wc.has_value();
@@ -211,7 +211,7 @@ TEST(Pipeline, RealTimeEventsArriveOnTheCallersThread) {
 // An observer may leave from inside its own callback.
 TEST(Pipeline, ObserverCanRemoveItselfDuringACallback) {
   struct OneShot final : Observer {
-    Slam* slam = nullptr;
+    Pipeline* slam = nullptr;
     int calls = 0;
     void on_frame(const FrameResult&) override {
       ++calls;
@@ -220,7 +220,7 @@ TEST(Pipeline, ObserverCanRemoveItselfDuringACallback) {
   };
   Settings s = default_settings();
   apply_setting_overrides(s, {"semantic.detector=none"});
-  Slam slam(s);
+  Pipeline slam(s);
   OneShot once;
   once.slam = &slam;
   Tally tally;

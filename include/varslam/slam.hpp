@@ -1,0 +1,94 @@
+#pragma once
+// varslam::Slam: one SLAM session (C++17). Feed it colour + depth frames; it returns each frame's pose at once and
+// maps, closes loops and relocalizes behind it. Conventions (frames, axes, units, timestamps): <varslam/types.hpp>.
+//
+// Threads. track(), finish(), reset(), load_map() and set_localization_only() are called from one thread (the
+// "tracking thread"). From any other thread, at any time, these may be called while track() runs: map_snapshot(),
+// live_trajectory(), save_map(), summary(). Listener callbacks run on the tracking thread, inside track() or
+// finish(); they must not call back into the session.
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core/mat.hpp>
+#include <varslam/config.hpp>
+#include <varslam/error.hpp>
+#include <varslam/types.hpp>
+
+namespace varslam {
+
+enum class Mode {
+  Deterministic,  // every stage in the caller's thread: the same input gives the same output (tests, benchmarks)
+  RealTime,       // local mapping, loop closing and the person detector on their own threads: track() never waits
+                  // for a Local BA
+};
+
+/// What the session reports besides the poses. Override what you need.
+class Listener {
+ public:
+  virtual ~Listener() = default;
+  virtual void on_local_ba(const LocalBaInfo&) {}
+  virtual void on_loop(const LoopInfo&) {}
+  virtual void on_person_boxes(const PersonBoxesInfo&) {}
+};
+
+struct SessionSummary {
+  std::size_t frames = 0, tracked = 0, keyframes = 0, map_points = 0;
+  int segments = 0, relocalizations = 0;
+  std::string person_detector;  // "none" without the person filter
+};
+
+class Slam {
+ public:
+  /// Throws ConfigError for bad settings and InputError when the person detector's model cannot be loaded.
+  explicit Slam(const Config& config, Mode mode = Mode::Deterministic);
+  ~Slam();  // stops the worker threads (finish() first to keep the map complete)
+  Slam(const Slam&) = delete;
+  Slam& operator=(const Slam&) = delete;
+
+  /// Tracks one frame. Throws InputError for an image of the wrong size or type, or a timestamp that is not
+  /// finite or not after the previous frame's (the frame is then not used; the session goes on).
+  TrackedFrame track(const cv::Mat& bgr, const cv::Mat& depth, double timestamp);
+  /// The same with the people in this image from the caller's own detector (the person filter uses them as they are).
+  TrackedFrame track(const cv::Mat& bgr, const cv::Mat& depth, double timestamp, const std::vector<PersonBox>& people);
+
+  /// Finishes local mapping and loop closing so the map and camera_trajectory() are final. Later track() calls are
+  /// an error (reset() starts again).
+  void finish();
+  /// Forgets the map and trajectories and starts again with the same settings (a loaded map is loaded again, and
+  /// localization-only stays on; without a loaded map it goes off).
+  void reset();
+
+  /// Starts from a map saved by save_map(): the session is reset and the next frames relocalize in the map. The map
+  /// brings its camera. Throws InputError naming the file when it is not a usable map.
+  void load_map(const std::string& file);
+  /// Tracks in the map without extending it (no keyframes, no points): the live pose in a known map.
+  void set_localization_only(bool on);
+  /// Writes the map (atomically). While running in real-time mode, local mapping pauses until its queue is drained
+  /// (about one Local BA) so the copy is consistent; tracking waits meanwhile.
+  void save_map(const std::string& file);
+
+  /// The latest consistent copy of the map, refreshed after every keyframe and whenever a caller asked since the
+  /// last frame (so it is at most one frame old).
+  std::shared_ptr<const MapSnapshot> map_snapshot() const;
+  /// Each frame's pose as tracking gave it (a copy).
+  std::vector<TimedPose> live_trajectory() const;
+  /// Every tracked frame's pose after every correction so far (Local BA, loops). Tracking thread, or after finish().
+  std::vector<TimedPose> camera_trajectory() const;
+  SessionSummary summary() const;
+
+  /// Not owned; must outlive the session or be removed first. Tracking thread only.
+  void add_listener(Listener& listener);
+  void remove_listener(Listener& listener);
+
+  Mode mode() const;
+  /// The library's version, e.g. "0.1.0".
+  static std::string version();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace varslam

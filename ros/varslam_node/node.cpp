@@ -1,0 +1,366 @@
+#include "node.hpp"
+
+#include <boost/bind/bind.hpp>
+#include <cv_bridge/cv_bridge.h>
+#include <geometry_msgs/TransformStamped.h>
+#include <nav_msgs/Odometry.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <sensor_msgs/image_encodings.h>
+#include <sensor_msgs/point_cloud2_iterator.h>
+#include <std_msgs/Float64.h>
+#include <std_msgs/String.h>
+#include <tf2_msgs/TFMessage.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <fstream>
+#include <future>
+#include <opencv2/imgproc.hpp>
+
+namespace varslam_ros {
+namespace {
+
+namespace enc = sensor_msgs::image_encodings;
+
+geometry_msgs::Pose to_msg(const varslam::Pose& p) {
+  geometry_msgs::Pose m;
+  m.position.x = p.translation[0];
+  m.position.y = p.translation[1];
+  m.position.z = p.translation[2];
+  m.orientation.x = p.rotation[0];
+  m.orientation.y = p.rotation[1];
+  m.orientation.z = p.rotation[2];
+  m.orientation.w = p.rotation[3];
+  return m;
+}
+
+const char* state_name(varslam::TrackingState s) {
+  switch (s) {
+    case varslam::TrackingState::Tracking: return "tracking";
+    case varslam::TrackingState::Lost: return "lost";
+    case varslam::TrackingState::NotInitialized: return "not_initialized";
+  }
+  return "unknown";
+}
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0;
+  const auto k = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5);
+  std::nth_element(v.begin(), v.begin() + static_cast<long>(k), v.end());
+  return v[k];
+}
+
+// Depth as the session takes it: CV_32FC1 metres, 0 where there is none.
+cv::Mat depth_metres(const sensor_msgs::ImageConstPtr& msg, double depth_unit) {
+  const cv_bridge::CvImageConstPtr d = cv_bridge::toCvShare(msg);
+  cv::Mat m;
+  if (msg->encoding == enc::TYPE_16UC1 || msg->encoding == enc::MONO16) {
+    d->image.convertTo(m, CV_32FC1, depth_unit);
+  } else if (msg->encoding == enc::TYPE_32FC1) {
+    m = d->image.clone();
+    cv::patchNaNs(m, 0.0);
+    cv::max(m, 0.0, m);
+  } else {
+    throw varslam::InputError("depth image of encoding '" + msg->encoding + "': expected 16UC1, mono16 or 32FC1");
+  }
+  return m;
+}
+
+}  // namespace
+
+VarslamNode::VarslamNode(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh), pnh_(pnh) {
+  params_ = read_params(pnh_, config_);
+  have_camera_ = !params_.settings_file.empty();
+  odom_pub_ = pnh_.advertise<nav_msgs::Odometry>("odometry", 100);
+  tf_pub_ = nh_.advertise<tf2_msgs::TFMessage>("/tf", 100);
+  path_pub_ = pnh_.advertise<nav_msgs::Path>("path", 1);
+  corrected_path_pub_ = pnh_.advertise<nav_msgs::Path>("corrected_path", 1, true);
+  points_pub_ = pnh_.advertise<sensor_msgs::PointCloud2>("map_points", 1, true);
+  keyframes_pub_ = pnh_.advertise<visualization_msgs::MarkerArray>("keyframes", 1, true);
+  state_pub_ = pnh_.advertise<std_msgs::String>("state", 10);
+  alpha_pub_ = pnh_.advertise<std_msgs::Float64>("local_ba_alpha", 10);
+  save_srv_ = pnh_.advertiseService("save_map", &VarslamNode::save_map, this);
+  load_srv_ = pnh_.advertiseService("load_map", &VarslamNode::load_map, this);
+  reset_srv_ = pnh_.advertiseService("reset", &VarslamNode::reset, this);
+  loc_srv_ = pnh_.advertiseService("localization_only", &VarslamNode::localization_only, this);
+  // Deep subscriber queues: a frame waits rather than being dropped while the tracking thread is busy.
+  rgb_sub_.subscribe(nh_, "rgb/image", 100);
+  depth_sub_.subscribe(nh_, "depth/image", 100);
+  sync_ = std::make_unique<message_filters::Synchronizer<SyncPolicy>>(SyncPolicy(100), rgb_sub_, depth_sub_);
+  sync_->registerCallback(boost::bind(&VarslamNode::on_images, this, boost::placeholders::_1, boost::placeholders::_2));
+  colour_count_sub_ = nh_.subscribe("rgb/image", 100, &VarslamNode::on_colour_seen, this);
+  if (!have_camera_) info_sub_ = nh_.subscribe("rgb/camera_info", 10, &VarslamNode::on_camera_info, this);
+  tracker_ = std::thread([this] { tracking_loop(); });
+  ROS_INFO("varslam %s: colour %s, depth %s, camera %s; %s mode", varslam::Slam::version().c_str(),
+           rgb_sub_.getTopic().c_str(), depth_sub_.getTopic().c_str(),
+           have_camera_ ? params_.settings_file.c_str() : nh_.resolveName("rgb/camera_info").c_str(),
+           params_.realtime ? "real-time" : "deterministic");
+}
+
+VarslamNode::~VarslamNode() {
+  {
+    std::lock_guard<std::mutex> lock(queue_mutex_);
+    stop_ = true;
+  }
+  queue_cv_.notify_all();
+  tracker_.join();
+  if (slam_) {
+    slam_->finish();
+    publish_corrected_path(ros::Time::now());
+  }
+  write_stats();
+}
+
+void VarslamNode::on_camera_info(const sensor_msgs::CameraInfoConstPtr& info) {
+  std::lock_guard<std::mutex> lock(queue_mutex_);
+  if (have_camera_) return;
+  try {
+    config_.set("camera.fx", info->K[0]).set("camera.fy", info->K[4]).set("camera.cx", info->K[2]);
+    config_.set("camera.cy", info->K[5]).set("camera.width", info->width).set("camera.height", info->height);
+    const char* keys[] = {"camera.k1", "camera.k2", "camera.p1", "camera.p2", "camera.k3"};
+    for (std::size_t k = 0; k < 5 && k < info->D.size(); ++k) config_.set(keys[k], info->D[k]);
+    apply_setting_params(pnh_, config_);  // parameters win over CameraInfo
+  } catch (const varslam::InputError& e) {
+    ROS_FATAL("CameraInfo on %s: %s", info_sub_.getTopic().c_str(), e.what());
+    ros::shutdown();
+    return;
+  }
+  have_camera_ = true;
+  ROS_INFO("camera from CameraInfo %s: fx %.3f fy %.3f cx %.3f cy %.3f, %ux%u", info_sub_.getTopic().c_str(),
+           info->K[0], info->K[4], info->K[2], info->K[5], info->width, info->height);
+  queue_cv_.notify_all();
+}
+
+void VarslamNode::on_images(const sensor_msgs::ImageConstPtr& rgb, const sensor_msgs::ImageConstPtr& depth) {
+  {
+    std::lock_guard<std::mutex> lock(queue_mutex_);
+    queue_.push_back({rgb, depth, Clock::now()});
+    ++stats_.synced;
+    stats_.max_queue = std::max(stats_.max_queue, queue_.size());
+  }
+  queue_cv_.notify_one();
+}
+
+void VarslamNode::tracking_loop() {
+  for (;;) {
+    Pending p;
+    {
+      std::unique_lock<std::mutex> lock(queue_mutex_);
+      queue_cv_.wait(lock, [&] { return stop_ || (!queue_.empty() && have_camera_); });
+      if (queue_.empty() || !have_camera_) return;  // stopping
+      p = std::move(queue_.front());
+      queue_.pop_front();
+    }
+    while (services_waiting_.load() > 0) std::this_thread::yield();
+    std::lock_guard<std::mutex> session(session_mutex_);
+    track(p);
+  }
+}
+
+bool VarslamNode::ensure_session(const sensor_msgs::Image& rgb) {
+  if (slam_) return true;
+  {
+    std::lock_guard<std::mutex> lock(queue_mutex_);
+    slam_ = std::make_unique<varslam::Slam>(config_, params_.realtime ? varslam::Mode::RealTime
+                                                                       : varslam::Mode::Deterministic);
+  }
+  slam_->add_listener(*this);
+  if (params_.camera_frame.empty()) params_.camera_frame = rgb.header.frame_id.empty() ? "camera" : rgb.header.frame_id;
+  if (params_.load_map_at_start) slam_->load_map(params_.map_file);
+  if (params_.localization_only) slam_->set_localization_only(true);
+  return true;
+}
+
+void VarslamNode::track(const Pending& p) {
+  try {
+    ensure_session(*p.rgb);
+    const cv_bridge::CvImageConstPtr colour = cv_bridge::toCvShare(p.rgb, enc::BGR8);
+    const cv::Mat depth = depth_metres(p.depth, params_.depth_unit);
+    const varslam::TrackedFrame f = slam_->track(colour->image, depth, p.rgb->header.stamp.toSec());
+    publish_pose(f, p.rgb->header);
+    stats_.latency_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - p.received).count());
+    if (f.pose) ++stats_.tracked; else ++stats_.lost;
+    if (f.keyframe && ++keyframes_since_map_ >= static_cast<std::size_t>(params_.map_every_keyframes)) {
+      keyframes_since_map_ = 0;
+      publish_map(p.rgb->header.stamp);
+      publish_corrected_path(p.rgb->header.stamp);
+    }
+  } catch (const varslam::InputError& e) {
+    ++stats_.rejected;
+    ROS_WARN_THROTTLE(2.0, "frame at %.6f not used: %s", p.rgb->header.stamp.toSec(), e.what());
+  } catch (const cv_bridge::Exception& e) {
+    ++stats_.rejected;
+    ROS_WARN_THROTTLE(2.0, "frame at %.6f not used: %s", p.rgb->header.stamp.toSec(), e.what());
+  }
+}
+
+void VarslamNode::publish_pose(const varslam::TrackedFrame& f, const std_msgs::Header& header) {
+  std_msgs::String state;
+  state.data = state_name(f.state);
+  state_pub_.publish(state);
+  if (!f.pose) return;
+  nav_msgs::Odometry odom;
+  odom.header.stamp = header.stamp;
+  odom.header.frame_id = params_.map_frame;
+  odom.child_frame_id = params_.camera_frame;
+  odom.pose.pose = to_msg(*f.pose);
+  odom_pub_.publish(odom);
+  geometry_msgs::TransformStamped t;
+  t.header = odom.header;
+  t.child_frame_id = params_.camera_frame;
+  t.transform.translation.x = odom.pose.pose.position.x;
+  t.transform.translation.y = odom.pose.pose.position.y;
+  t.transform.translation.z = odom.pose.pose.position.z;
+  t.transform.rotation = odom.pose.pose.orientation;
+  tf2_msgs::TFMessage tf;
+  tf.transforms.push_back(t);
+  tf_pub_.publish(tf);
+  geometry_msgs::PoseStamped ps;
+  ps.header = odom.header;
+  ps.pose = odom.pose.pose;
+  live_path_.header = odom.header;
+  live_path_.poses.push_back(ps);
+  if (path_pub_.getNumSubscribers() > 0) path_pub_.publish(live_path_);
+}
+
+void VarslamNode::publish_map(const ros::Time& stamp) {
+  const std::shared_ptr<const varslam::MapSnapshot> map = slam_->map_snapshot();
+  sensor_msgs::PointCloud2 cloud;
+  cloud.header.stamp = stamp;
+  cloud.header.frame_id = params_.map_frame;
+  sensor_msgs::PointCloud2Modifier mod(cloud);
+  mod.setPointCloud2FieldsByString(1, "xyz");
+  mod.resize(map->points.size());
+  sensor_msgs::PointCloud2Iterator<float> x(cloud, "x"), y(cloud, "y"), z(cloud, "z");
+  for (const auto& p : map->points) {
+    *x = static_cast<float>(p.position[0]);
+    *y = static_cast<float>(p.position[1]);
+    *z = static_cast<float>(p.position[2]);
+    ++x, ++y, ++z;
+  }
+  points_pub_.publish(cloud);
+  visualization_msgs::MarkerArray markers;
+  visualization_msgs::Marker m;
+  m.header = cloud.header;
+  m.ns = "keyframes";
+  m.id = 0;
+  m.type = visualization_msgs::Marker::SPHERE_LIST;
+  m.action = visualization_msgs::Marker::ADD;
+  m.pose.orientation.w = 1;
+  m.scale.x = m.scale.y = m.scale.z = 0.03;
+  m.color.r = 0.2f, m.color.g = 0.6f, m.color.b = 1.0f, m.color.a = 1.0f;
+  for (const auto& kf : map->keyframes) {
+    geometry_msgs::Point pt;
+    pt.x = kf.pose.translation[0], pt.y = kf.pose.translation[1], pt.z = kf.pose.translation[2];
+    m.points.push_back(pt);
+  }
+  markers.markers.push_back(m);
+  keyframes_pub_.publish(markers);
+}
+
+void VarslamNode::publish_corrected_path(const ros::Time& stamp) {
+  nav_msgs::Path path;
+  path.header.stamp = stamp;
+  path.header.frame_id = params_.map_frame;
+  for (const varslam::TimedPose& p : slam_->camera_trajectory()) {
+    geometry_msgs::PoseStamped ps;
+    ps.header.stamp = ros::Time(p.timestamp);
+    ps.header.frame_id = params_.map_frame;
+    ps.pose = to_msg(p.pose);
+    path.poses.push_back(ps);
+  }
+  corrected_path_pub_.publish(path);
+}
+
+void VarslamNode::on_local_ba(const varslam::LocalBaInfo& info) {
+  std_msgs::Float64 a;
+  a.data = info.alpha;
+  alpha_pub_.publish(a);
+}
+
+// Services run between frames: they hold the session lock the tracking thread holds for each frame.
+std::unique_lock<std::mutex> VarslamNode::lock_for_service() {
+  ++services_waiting_;
+  std::unique_lock<std::mutex> lock(session_mutex_);
+  --services_waiting_;
+  return lock;
+}
+
+bool VarslamNode::save_map(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  const auto lock = lock_for_service();
+  if (params_.map_file.empty()) {
+    res.success = false;
+    res.message = "no ~map_file parameter: where to save the map";
+    return true;
+  }
+  try {
+    if (!slam_) throw varslam::InputError("no map yet: no frame was tracked");
+    slam_->save_map(params_.map_file);  // thread-safe: waits for the current frame
+    res.success = true;
+    res.message = "map saved to " + params_.map_file;
+  } catch (const varslam::InputError& e) {
+    res.success = false;
+    res.message = e.what();
+  }
+  return true;
+}
+
+bool VarslamNode::load_map(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  if (params_.map_file.empty()) {
+    res.success = false;
+    res.message = "no ~map_file parameter: which map to load";
+    return true;
+  }
+  const auto lock = lock_for_service();
+  try {
+    if (!slam_) {
+      params_.load_map_at_start = true;
+      res.message = "the map will be loaded with the first frame: " + params_.map_file;
+    } else {
+      slam_->load_map(params_.map_file);
+      live_path_.poses.clear();
+      res.message = "map loaded from " + params_.map_file + "; relocalizing in it";
+    }
+    res.success = true;
+  } catch (const varslam::InputError& e) {
+    res.success = false;
+    res.message = e.what();
+  }
+  return true;
+}
+
+bool VarslamNode::reset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  const auto lock = lock_for_service();
+  if (slam_) slam_->reset();
+  live_path_.poses.clear();
+  res.success = true;
+  res.message = "session reset";
+  return true;
+}
+
+bool VarslamNode::localization_only(std_srvs::SetBool::Request& req, std_srvs::SetBool::Response& res) {
+  const auto lock = lock_for_service();
+  try {
+    if (!slam_) throw varslam::InputError("no session yet: no frame was tracked");
+    slam_->set_localization_only(req.data);
+    params_.localization_only = req.data;
+    res.success = true;
+    res.message = req.data ? "localization only: the map is not extended" : "mapping";
+  } catch (const varslam::InputError& e) {
+    res.success = false;
+    res.message = e.what();
+  }
+  return true;
+}
+
+void VarslamNode::write_stats() const {
+  if (params_.stats_file.empty()) return;
+  std::ofstream out(params_.stats_file);
+  out << "{\"colour_messages\": " << colour_seen_.load() << ", \"synced_pairs\": " << stats_.synced
+      << ", \"tracked\": " << stats_.tracked << ", \"lost\": " << stats_.lost << ", \"rejected\": " << stats_.rejected
+      << ", \"max_queue\": " << stats_.max_queue << ", \"latency_ms_median\": " << percentile(stats_.latency_ms, 0.5)
+      << ", \"latency_ms_p95\": " << percentile(stats_.latency_ms, 0.95) << "}\n";
+}
+
+}  // namespace varslam_ros

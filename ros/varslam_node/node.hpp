@@ -1,0 +1,93 @@
+#pragma once
+// varslam as a ROS 1 node: a thin adapter over the public API (varslam::Slam). Synchronised colour + depth in,
+// odometry, TF, paths, map points, keyframes, tracking state and Local BA alpha out; services to save and load the
+// map, switch localization-only and reset. No SLAM logic here.
+#include <message_filters/subscriber.h>
+#include <nav_msgs/Path.h>
+#include <message_filters/sync_policies/approximate_time.h>
+#include <message_filters/synchronizer.h>
+#include <ros/ros.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <std_srvs/SetBool.h>
+#include <std_srvs/Trigger.h>
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <thread>
+#include <varslam/varslam.hpp>
+
+#include "param_config.hpp"
+
+namespace varslam_ros {
+
+class VarslamNode : public varslam::Listener {
+ public:
+  /// Throws varslam::ConfigError / InputError for bad parameters or settings (the node then stops).
+  VarslamNode(ros::NodeHandle nh, ros::NodeHandle pnh);
+  ~VarslamNode() override;  // stops the tracking thread, finishes the session, writes ~stats_file
+
+  void on_local_ba(const varslam::LocalBaInfo& info) override;
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  using SyncPolicy = message_filters::sync_policies::ApproximateTime<sensor_msgs::Image, sensor_msgs::Image>;
+  struct Pending {
+    sensor_msgs::ImageConstPtr rgb, depth;
+    Clock::time_point received;
+  };
+
+  void on_images(const sensor_msgs::ImageConstPtr& rgb, const sensor_msgs::ImageConstPtr& depth);
+  void on_camera_info(const sensor_msgs::CameraInfoConstPtr& info);
+  void on_colour_seen(const sensor_msgs::ImageConstPtr&) { ++colour_seen_; }
+  void tracking_loop();
+  void track(const Pending& p);
+  bool ensure_session(const sensor_msgs::Image& rgb);
+  void publish_pose(const varslam::TrackedFrame& f, const std_msgs::Header& header);
+  void publish_map(const ros::Time& stamp);
+  void publish_corrected_path(const ros::Time& stamp);
+  void write_stats() const;
+
+  bool save_map(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res);
+  bool load_map(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res);
+  bool reset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res);
+  bool localization_only(std_srvs::SetBool::Request& req, std_srvs::SetBool::Response& res);
+
+  ros::NodeHandle nh_, pnh_;
+  varslam::Config config_;
+  NodeParams params_;
+  bool have_camera_ = false;  // from ~settings_file or the first CameraInfo
+  std::unique_ptr<varslam::Slam> slam_;
+
+  message_filters::Subscriber<sensor_msgs::Image> rgb_sub_, depth_sub_;
+  std::unique_ptr<message_filters::Synchronizer<SyncPolicy>> sync_;
+  ros::Subscriber info_sub_, colour_count_sub_;
+  ros::Publisher odom_pub_, tf_pub_, path_pub_, corrected_path_pub_, points_pub_, keyframes_pub_, state_pub_,
+      alpha_pub_;
+  ros::ServiceServer save_srv_, load_srv_, reset_srv_, loc_srv_;
+
+  // Frames wait here for the tracking thread: the callbacks never wait on SLAM, and no frame is dropped.
+  std::mutex queue_mutex_;
+  std::condition_variable queue_cv_;
+  std::deque<Pending> queue_;
+  bool stop_ = false;
+  std::thread tracker_;
+  std::mutex session_mutex_;  // held by the tracking thread for each frame, and by the services
+  std::atomic<int> services_waiting_{0};  // the tracking thread lets a waiting service in before its next frame
+  std::unique_lock<std::mutex> lock_for_service();
+
+  // Owned by the tracking thread (stats_ also read by write_stats after it stopped).
+  nav_msgs::Path live_path_;
+  std::size_t keyframes_since_map_ = 0;
+  struct Stats {
+    std::size_t synced = 0, tracked = 0, lost = 0, rejected = 0, max_queue = 0;
+    std::vector<double> latency_ms;  // receipt of the pair to the published pose
+  } stats_;
+  std::atomic<std::size_t> colour_seen_{0};
+};
+
+}  // namespace varslam_ros

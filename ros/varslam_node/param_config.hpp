@@ -1,0 +1,31 @@
+#pragma once
+// The node's private parameters: its own (frames, topics, files) and, under the settings registry's names with '/'
+// for '.', every varslam setting (~tracking/kernel: huber), checked as `varslam run --set` checks them.
+#include <ros/node_handle.h>
+
+#include <string>
+#include <varslam/config.hpp>
+
+namespace varslam_ros {
+
+struct NodeParams {
+  std::string settings_file;        // ~settings_file: a varslam or ORB-SLAM3 settings file (else CameraInfo)
+  std::string map_frame = "map";    // ~map_frame
+  std::string camera_frame;         // ~camera_frame (default: the colour image's frame_id)
+  std::string map_file;             // ~map_file: what ~save_map writes and ~load_map reads
+  bool load_map_at_start = false;   // ~load_map_at_start: start in ~map_file
+  bool localization_only = false;   // ~localization_only (with a loaded map)
+  bool realtime = true;             // ~realtime: false = deterministic (every stage in the tracking thread)
+  double depth_unit = 0.001;        // ~depth_unit: metres per step of 16-bit depth (REP 118: millimetres)
+  int map_every_keyframes = 1;      // ~map_every_keyframes: publish the map points every N keyframes
+  std::string stats_file;           // ~stats_file: JSON written at shutdown (frames, drops, latency)
+};
+
+/// Reads the node's parameters and applies every other private parameter to `config` as a setting. Throws
+/// varslam::ConfigError naming the parameter for an unknown key or a bad value.
+NodeParams read_params(const ros::NodeHandle& private_nh, varslam::Config& config);
+
+/// The settings given as parameters (applied to a Config once it exists: after the first CameraInfo).
+void apply_setting_params(const ros::NodeHandle& private_nh, varslam::Config& config);
+
+}  // namespace varslam_ros

@@ -1,0 +1,279 @@
+// varslam::Slam: the public session over the internal pipeline (pipeline/slam.hpp), with plain value types, input
+// checks and the thread-safe views a consumer thread reads.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <thread>
+#include <varslam/slam.hpp>
+
+#include "api/config_access.hpp"
+#include "pipeline/slam.hpp"
+#include "slam/keyframe.hpp"
+#include "slam/map.hpp"
+#include "slam/map_point.hpp"
+
+namespace varslam {
+namespace detail {
+void default_library_log();
+}
+
+namespace {
+
+Pose to_pose(const Eigen::Isometry3d& T) {
+  const Eigen::Quaterniond q(T.rotation());
+  const Eigen::Vector3d t = T.translation();
+  Pose p;
+  p.translation = {t.x(), t.y(), t.z()};
+  p.rotation = {q.x(), q.y(), q.z(), q.w()};
+  return p;
+}
+
+std::vector<TimedPose> to_timed(const Trajectory& t) {
+  std::vector<TimedPose> out;
+  out.reserve(t.size());
+  for (const auto& p : t) out.push_back({p.timestamp, to_pose(p.T_wc)});
+  return out;
+}
+
+TrackingState to_state(slam::TrackState s) {
+  switch (s) {
+    case slam::TrackState::Ok: return TrackingState::Tracking;
+    case slam::TrackState::Lost: return TrackingState::Lost;
+    case slam::TrackState::NotInitialized: return TrackingState::NotInitialized;
+  }
+  return TrackingState::Lost;
+}
+
+}  // namespace
+
+struct Slam::Impl final : Observer {
+  Settings settings;
+  Mode mode;
+  std::optional<std::string> map_file;  // loaded again by reset()
+  bool localization_only = false;
+  std::unique_ptr<Pipeline> pipeline;
+  std::vector<Listener*> listeners;
+
+  // Held by the tracking thread for a whole frame, and by the calls other threads may make that touch the pipeline.
+  // Those announce themselves in `waiting` first and track() lets them in before its next frame, so a caller on
+  // another thread is never starved by a tracking loop that takes the lock again at once.
+  mutable std::mutex pipeline_mutex;
+  mutable std::atomic<int> waiting{0};
+  mutable std::mutex views_mutex;  // the three views below
+  std::shared_ptr<const MapSnapshot> snapshot = std::make_shared<MapSnapshot>();
+  std::vector<TimedPose> live;
+  SessionSummary summary;
+  mutable std::atomic<bool> snapshot_wanted{false};
+
+  std::optional<double> last_timestamp;
+  bool relocalized_now = false;
+
+  Impl(const Config& config, Mode m) : settings(detail::ConfigAccess::settings(config)), mode(m) { rebuild(); }
+
+  void rebuild() {
+    PipelineOptions o;
+    o.mode = mode == Mode::RealTime ? RunMode::RealTime : RunMode::Deterministic;
+    auto p = std::make_unique<Pipeline>(settings, std::move(o));
+    if (map_file) p->load_map(*map_file);
+    if (!map_file) localization_only = false;  // a new session without a map has nothing to localize in
+    if (localization_only) p->set_localization_only(true);
+    p->add_observer(*this);
+    pipeline = std::move(p);
+    last_timestamp.reset();
+    std::lock_guard lock(views_mutex);
+    snapshot = std::make_shared<MapSnapshot>();
+    live.clear();
+    summary = {};
+    summary.person_detector = pipeline->summary().detector;
+  }
+
+  void check_timestamp(double t) const {
+    if (!std::isfinite(t)) throw InputError(fmt::format("frame timestamp {} is not a finite number", t));
+    if (last_timestamp && t <= *last_timestamp)
+      throw InputError(fmt::format("frame timestamp {:.6f} is not after the previous frame's ({:.6f}): timestamps "
+                                   "must increase",
+                                   t, *last_timestamp));
+  }
+
+  // The pipeline lock for a call from another thread (see `waiting`).
+  std::unique_lock<std::mutex> lock_from_other_thread() const {
+    ++waiting;
+    std::unique_lock lock(pipeline_mutex);
+    --waiting;
+    return lock;
+  }
+
+  TrackedFrame track(const cv::Mat& bgr, const cv::Mat& depth, double t, const std::optional<Detections>& boxes) {
+    while (waiting.load() > 0) std::this_thread::yield();
+    std::lock_guard lock(pipeline_mutex);
+    check_timestamp(t);
+    relocalized_now = false;
+    const FrameResult r = pipeline->track(bgr, depth, t, boxes);
+    last_timestamp = t;
+    TrackedFrame f;
+    f.index = r.index;
+    f.timestamp = r.timestamp;
+    f.state = to_state(r.state);
+    if (r.T_wc) f.pose = to_pose(*r.T_wc);
+    f.keyframe = r.keyframe;
+    f.keyframe_id = r.keyframe_id;
+    f.new_segment = r.new_segment;
+    f.relocalized = relocalized_now;
+    f.keypoints = r.keypoints;
+    f.inliers = r.inliers;
+    f.map_keyframes = r.map_keyframes;
+    f.map_points = r.map_points;
+    f.tracking_ms = r.timings.track_ms;
+    const PipelineSummary p = pipeline->summary();
+    std::size_t snapshot_keyframes = 0;
+    {
+      std::lock_guard views(views_mutex);
+      if (f.pose) live.push_back({t, *f.pose});
+      summary = {p.frames, p.tracked, p.keyframes, p.map_points, p.segments, p.relocalizations, p.detector};
+      snapshot_keyframes = snapshot->keyframes.size();
+    }
+    // Also when the map changed without a keyframe of this session (a loaded map adopted, keyframes culled).
+    if (r.keyframe || snapshot_wanted.exchange(false) || snapshot_keyframes != r.map_keyframes)
+      refresh_snapshot(r.index + 1);
+    return f;
+  }
+
+  // On the tracking thread: the map's lists are copied under its lock, each point's position under its own.
+  void refresh_snapshot(std::size_t frames) {
+    auto s = std::make_shared<MapSnapshot>();
+    s->frame_index = frames;
+    const slam::Map& map = pipeline->map();
+    for (const auto& kf : map.keyframes())
+      if (!kf->is_bad()) s->keyframes.push_back({kf->id(), kf->timestamp(), to_pose(kf->pose_inverse())});
+    for (const auto& mp : map.map_points()) {
+      if (mp->is_bad()) continue;
+      const Eigen::Vector3d x = mp->position();
+      s->points.push_back({mp->id(), {x.x(), x.y(), x.z()}, mp->num_observations()});
+    }
+    std::lock_guard lock(views_mutex);
+    snapshot = std::move(s);
+  }
+
+  void on_keyframe_mapped(const slam::KeyframeMapped& m) override {
+    if (!m.ba) return;
+    const LocalBaInfo info{m.keyframe_id,       m.timestamp,          m.ba->final_alpha, m.ba->fitted_alpha,
+                           m.ba->keyframes,    m.ba->points,         m.ba->observations, m.ba->outliers,
+                           m.ba->ms};
+    for (Listener* l : listeners) l->on_local_ba(info);
+  }
+  void on_loop(const slam::LoopRecord& l) override {
+    const LoopInfo info{l.query_keyframe, l.loop_keyframe, l.timestamp, l.correction_m, l.correction_deg};
+    for (Listener* x : listeners) x->on_loop(info);
+  }
+  void on_relocalization(const RelocalizationEvent&) override { relocalized_now = true; }
+  void on_detection(const DetectionEvent& e) override {
+    PersonBoxesInfo info;
+    info.index = e.index;
+    info.timestamp = e.timestamp;
+    info.box_age_s = e.box_age_s;
+    for (const auto& d : e.boxes) info.boxes.push_back({d.box.x, d.box.y, d.box.width, d.box.height, d.score});
+    for (Listener* l : listeners) l->on_person_boxes(info);
+  }
+};
+
+Slam::Slam(const Config& config, Mode mode) {
+  detail::default_library_log();
+  impl_ = std::make_unique<Impl>(config, mode);
+}
+
+Slam::~Slam() = default;
+
+TrackedFrame Slam::track(const cv::Mat& bgr, const cv::Mat& depth, double timestamp) {
+  return impl_->track(bgr, depth, timestamp, std::nullopt);
+}
+
+TrackedFrame Slam::track(const cv::Mat& bgr, const cv::Mat& depth, double timestamp,
+                         const std::vector<PersonBox>& people) {
+  Detections d;
+  for (const PersonBox& b : people) {
+    if (!std::isfinite(b.x) || !std::isfinite(b.y) || !std::isfinite(b.width) || !std::isfinite(b.height) ||
+        b.width <= 0 || b.height <= 0)
+      throw InputError(fmt::format("person box ({}, {}, {} x {}) is not a box with finite, positive size", b.x, b.y,
+                                   b.width, b.height));
+    d.push_back({timestamp, "person", b.score, cv::Rect2f(b.x, b.y, b.width, b.height)});
+  }
+  return impl_->track(bgr, depth, timestamp, d);
+}
+
+void Slam::finish() {
+  std::lock_guard lock(impl_->pipeline_mutex);
+  impl_->pipeline->finish();
+  const PipelineSummary p = impl_->pipeline->summary();
+  impl_->refresh_snapshot(p.frames);
+  std::lock_guard views(impl_->views_mutex);
+  impl_->summary = {p.frames, p.tracked, p.keyframes, p.map_points, p.segments, p.relocalizations, p.detector};
+}
+
+void Slam::reset() {
+  std::lock_guard lock(impl_->pipeline_mutex);
+  impl_->rebuild();
+}
+
+void Slam::load_map(const std::string& file) {
+  std::lock_guard lock(impl_->pipeline_mutex);
+  const std::optional<std::string> before = impl_->map_file;
+  impl_->map_file = file;
+  try {
+    impl_->rebuild();
+  } catch (...) {
+    impl_->map_file = before;
+    impl_->rebuild();
+    throw;
+  }
+}
+
+void Slam::set_localization_only(bool on) {
+  std::lock_guard lock(impl_->pipeline_mutex);
+  if (on && !impl_->map_file && impl_->pipeline->summary().keyframes == 0)
+    throw InputError("localization only needs a map to localize in: load_map() first, or track until there is one");
+  impl_->pipeline->set_localization_only(on);
+  impl_->localization_only = on;
+}
+
+void Slam::save_map(const std::string& file) {
+  const auto lock = impl_->lock_from_other_thread();
+  impl_->pipeline->save_map(file);
+}
+
+std::shared_ptr<const MapSnapshot> Slam::map_snapshot() const {
+  impl_->snapshot_wanted = true;
+  std::lock_guard lock(impl_->views_mutex);
+  return impl_->snapshot;
+}
+
+std::vector<TimedPose> Slam::live_trajectory() const {
+  std::lock_guard lock(impl_->views_mutex);
+  return impl_->live;
+}
+
+std::vector<TimedPose> Slam::camera_trajectory() const {
+  const auto lock = impl_->lock_from_other_thread();
+  return to_timed(impl_->pipeline->camera_trajectory());
+}
+
+SessionSummary Slam::summary() const {
+  std::lock_guard lock(impl_->views_mutex);
+  return impl_->summary;
+}
+
+void Slam::add_listener(Listener& l) { impl_->listeners.push_back(&l); }
+
+void Slam::remove_listener(Listener& l) {
+  auto& v = impl_->listeners;
+  v.erase(std::remove(v.begin(), v.end(), &l), v.end());
+}
+
+Mode Slam::mode() const { return impl_->mode; }
+
+std::string Slam::version() { return std::string(kVersion); }
+
+}  // namespace varslam

@@ -1,0 +1,171 @@
+// The public API as a library user meets it: settings set in code are used, bad frames and times are InputErrors
+// that leave the session going, the map and trajectory views are read from another thread while track() runs
+// (also under ThreadSanitizer: scripts/sanitize.sh), maps are saved while running and found again, reset starts
+// over, and nothing is written to standard output.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <thread>
+#include <varslam/varslam.hpp>
+
+#include "io/dataset.hpp"
+#include "slam/e2e_support.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::AllOf;
+using ::testing::HasSubstr;
+
+struct Sequence {
+  varslam::Config config;
+  std::vector<varslam::RgbdFrame> frames;
+};
+
+const Sequence& sequence() {
+  static const Sequence s = [] {
+    const fs::path dir = varslam::slam::e2e::pipeline_walking_sequence();
+    Sequence seq;
+    seq.config = varslam::Config::from_file((dir / "settings.yaml").string());
+    seq.config.set("semantic.detector", "none");
+    const auto ds = varslam::open_dataset(dir, varslam::settings_for_dataset(dir, std::nullopt));
+    for (std::size_t i = 0; i < ds->size(); ++i) seq.frames.push_back(ds->load(i));
+    return seq;
+  }();
+  return s;
+}
+
+template <typename Fn>
+std::string input_error(Fn fn) {
+  try {
+    fn();
+  } catch (const varslam::InputError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+TEST(ApiConfig, KeysAreCheckedWhenSetAndReadBack) {
+  varslam::Config c;
+  c.set("camera.fx", 600.0).set("tracking.kernel", "huber");
+  EXPECT_EQ(c.get("camera.fx"), "600");
+  EXPECT_EQ(c.get("tracking.kernel"), "huber");
+  EXPECT_TRUE(c.given("camera.fx"));
+  EXPECT_FALSE(c.given("mapping.tau"));
+  EXPECT_THAT(input_error([&] { c.set("tracking.kernl", "huber"); }), HasSubstr("tracking.kernel"));
+  EXPECT_THAT(input_error([&] { c.set("camera.fx", "nan"); }), HasSubstr("camera.fx"));
+  EXPECT_THAT(input_error([&] { c.get("camera.focal"); }), HasSubstr("unknown settings key 'camera.focal'"));
+  const varslam::Config copy = c;  // a deep copy: changing one leaves the other
+  c.set("camera.fx", 500.0);
+  EXPECT_EQ(copy.get("camera.fx"), "600");
+  EXPECT_GT(varslam::Config::keys().size(), 50u);
+  EXPECT_EQ(varslam::Config::from_yaml("camera: {fx: 500, fy: 502, cx: 320, cy: 240}").get("camera.fy"), "502");
+}
+
+TEST(ApiSlam, SettingsSetInCodeAreTheOnesUsed) {
+  varslam::Config c = sequence().config;
+  c.set("camera.width", 320.0);
+  varslam::Slam slam(c);
+  const auto& f = sequence().frames[0];
+  EXPECT_THAT(input_error([&] { slam.track(f.bgr, f.depth, f.timestamp); }), HasSubstr("320"));
+}
+
+TEST(ApiSlam, BadTimestampsAndImagesAreInputErrorsAndTheSessionGoesOn) {
+  varslam::Slam slam(sequence().config);
+  const auto& fr = sequence().frames;
+  ASSERT_TRUE(slam.track(fr[0].bgr, fr[0].depth, fr[0].timestamp).pose);
+  EXPECT_THAT(input_error([&] { slam.track(fr[1].bgr, fr[1].depth, std::nan("")); }), HasSubstr("not a finite"));
+  EXPECT_THAT(input_error([&] { slam.track(fr[1].bgr, fr[1].depth, fr[0].timestamp); }), HasSubstr("not after"));
+  EXPECT_THAT(input_error([&] { slam.track(fr[1].bgr, fr[1].depth, fr[0].timestamp - 1); }), HasSubstr("not after"));
+  EXPECT_THAT(input_error([&] { slam.track(cv::Mat(10, 10, CV_8UC3), fr[1].depth, fr[1].timestamp); }),
+              AllOf(HasSubstr("10"), HasSubstr("640")));
+  EXPECT_THAT(input_error([&] { slam.track(fr[1].bgr, fr[1].depth, fr[1].timestamp, {{1, 2, -5, 3, 1}}); }),
+              HasSubstr("person box"));
+  const varslam::TrackedFrame f = slam.track(fr[1].bgr, fr[1].depth, fr[1].timestamp);
+  EXPECT_EQ(f.state, varslam::TrackingState::Tracking);
+  EXPECT_EQ(slam.live_trajectory().size(), 2u);
+  for (const auto& p : slam.live_trajectory()) EXPECT_TRUE(std::isfinite(p.pose.translation[0]));
+}
+
+// The views other threads may read while track() runs, read as fast as they come (ThreadSanitizer runs this).
+TEST(ApiSlam, AConsumerThreadReadsTheMapAndTrajectoryWhileTracking) {
+  varslam::Slam slam(sequence().config, varslam::Mode::RealTime);
+  std::atomic<bool> done{false};
+  std::size_t reads = 0, most_keyframes = 0;
+  bool shrank = false;
+  std::thread reader([&] {
+    while (!done) {
+      const auto map = slam.map_snapshot();
+      shrank |= map->keyframes.size() + 2 < most_keyframes;  // culling may remove a few, never most
+      most_keyframes = std::max(most_keyframes, map->keyframes.size());
+      for (const auto& p : map->points) ASSERT_TRUE(std::isfinite(p.position[2]));
+      const auto live = slam.live_trajectory();
+      if (!live.empty()) {
+        ASSERT_TRUE(std::isfinite(live.back().pose.translation[0]));
+      }
+      (void)slam.summary();
+      ++reads;
+    }
+  });
+  for (const auto& f : sequence().frames) slam.track(f.bgr, f.depth, f.timestamp);
+  slam.finish();
+  done = true;
+  reader.join();
+  EXPECT_GT(reads, 10u);
+  EXPECT_FALSE(shrank);
+  EXPECT_GT(most_keyframes, 2u);
+  EXPECT_EQ(slam.map_snapshot()->keyframes.size(), slam.summary().keyframes);
+}
+
+TEST(ApiSlam, AMapSavedWhileRunningIsFoundAgainAndResetStartsOver) {
+  const auto& fr = sequence().frames;
+  const fs::path map = fs::temp_directory_path() / ("varslam_api_" + std::to_string(::getpid()) + ".map");
+  {
+    varslam::Slam slam(sequence().config, varslam::Mode::RealTime);
+    for (std::size_t i = 0; i < fr.size(); ++i) {
+      slam.track(fr[i].bgr, fr[i].depth, fr[i].timestamp);
+      if (i == fr.size() - 10) slam.save_map(map.string());  // while mapping runs
+    }
+    EXPECT_TRUE(fs::exists(map));
+    slam.reset();
+    EXPECT_EQ(slam.summary().frames, 0u);
+    EXPECT_EQ(slam.map_snapshot()->keyframes.size(), 0u);
+    EXPECT_TRUE(slam.track(fr[0].bgr, fr[0].depth, fr[0].timestamp).pose);  // a new map from here
+  }
+  varslam::Slam again(sequence().config);
+  again.load_map(map.string());
+  again.set_localization_only(true);
+  std::size_t localized = 0;
+  for (std::size_t i = 5; i < fr.size(); ++i) localized += again.track(fr[i].bgr, fr[i].depth, fr[i].timestamp).pose ? 1 : 0;
+  EXPECT_GT(localized, (fr.size() - 5) * 9 / 10);
+  EXPECT_EQ(again.summary().keyframes, again.map_snapshot()->keyframes.size());
+  fs::remove(map);
+}
+
+TEST(ApiSlam, ASessionWritesNothingToStandardOutput) {
+  (void)sequence();  // read by the test's own (internal) dataset reader, which logs
+  ::testing::internal::CaptureStdout();
+  {
+    varslam::Slam slam(sequence().config);
+    for (std::size_t i = 0; i < 10; ++i) slam.track(sequence().frames[i].bgr, sequence().frames[i].depth,
+                                                    sequence().frames[i].timestamp);
+    slam.finish();
+  }
+  EXPECT_EQ(::testing::internal::GetCapturedStdout(), "");
+}
+
+TEST(ApiLog, TheCallersSinkGetsTheLines) {
+  std::vector<std::string> lines;
+  varslam::set_log_sink([&](varslam::LogLevel, const std::string& l) { lines.push_back(l); }, varslam::LogLevel::Debug);
+  {
+    varslam::Slam slam(sequence().config);
+    for (std::size_t i = 0; i < 10; ++i)
+      slam.track(sequence().frames[i].bgr, sequence().frames[i].depth, sequence().frames[i].timestamp);
+  }
+  varslam::set_log_sink({}, varslam::LogLevel::Warn);
+  EXPECT_FALSE(lines.empty());
+}
+
+}  // namespace

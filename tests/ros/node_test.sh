@@ -1,0 +1,103 @@
+#!/usr/bin/env bash
+# varslam_node under a real roscore (started here on a free loopback port, stopped at the end), fed by `rosbag play`
+# of a bag written from a synthetic sequence at 1x: every frame gets a pose on ~odometry, TF is published, the
+# poses are as accurate as a direct real-time run of the folder (within that run's spread over repeats), the
+# services work, and a bad parameter stops the node with its message (exit 2).
+# Usage: node_test.sh BUILD_DIR
+set -euo pipefail
+build=$1
+bin=$build/bin
+work=$(mktemp -d)
+pids=()
+cleanup() {
+  for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
+  wait 2>/dev/null || true
+  rm -rf "$work"
+}
+trap cleanup EXIT
+fail() { echo "FAIL: $*"; for f in "$work"/*.log; do echo "--- $f"; tail -20 "$f"; done; exit 1; }
+
+port=$(/usr/bin/python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
+export ROS_MASTER_URI=http://127.0.0.1:$port ROS_IP=127.0.0.1 ROS_HOME=$work/ros_home
+unset ROS_HOSTNAME
+
+"$bin/varslam" synth --scenario walking --seconds 4 --seed 6 --no-preview --out "$work/seq" > /dev/null 2>&1
+"$bin/varslam" bag-from-folder -d "$work/seq" -o "$work/seq.bag" > /dev/null 2>&1
+frames=$(ls "$work/seq/rgb" | wc -l)
+
+# The reference: direct real-time runs of the folder, paced at the frame rate like the bag's playback.
+ates=()
+for i in 1 2 3; do
+  "$bin/varslam" run -q -d "$work/seq" -o "$work/direct$i" --realtime --pace --set semantic.detector=none \
+    > "$work/direct$i.log" 2>&1 || fail "direct run $i"
+  ates+=("$(/usr/bin/python3 -c "import json; print(json.load(open('$work/direct$i/metrics.json'))['ate_live']['rmse'])")")
+done
+
+roscore -p "$port" > "$work/roscore.log" 2>&1 &
+pids+=($!)
+for _ in $(seq 100); do rosparam list > /dev/null 2>&1 && break; sleep 0.2; done
+rosparam list > /dev/null 2>&1 || fail "roscore did not start"
+
+# A bad parameter stops the node with the registry's message.
+set +e
+timeout 30 "$bin/varslam_node" __name:=bad _tracking/kernel:=bogus > "$work/bad.log" 2>&1
+code=$?
+set -e
+[[ $code -eq 2 ]] || fail "bad parameter: exit $code, expected 2"
+grep -q "tracking.kernel" "$work/bad.log" || fail "bad parameter: no message naming tracking.kernel"
+grep -q "bogus" "$work/bad.log" || fail "bad parameter: the message does not name the value"
+
+"$bin/varslam_node" __name:=varslam rgb/image:=/camera/rgb/image_color depth/image:=/camera/depth/image \
+  rgb/camera_info:=/camera/rgb/camera_info _semantic/detector:=none _map_file:="$work/node.map" \
+  _stats_file:="$work/stats.json" > "$work/node.log" 2>&1 &
+node=$!
+pids+=($node)
+rosbag record -O "$work/out.bag" /varslam/odometry /tf /varslam/state > "$work/record.log" 2>&1 &
+rec=$!
+pids+=($rec)
+for _ in $(seq 100); do
+  rosservice list 2>/dev/null | grep -q /varslam/save_map && rostopic info /varslam/odometry 2>/dev/null | grep -q record && break
+  sleep 0.2
+done
+rosbag play -q "$work/seq.bag" > "$work/play.log" 2>&1 || fail "rosbag play"
+sleep 2  # the last frames through tracking and publishing
+
+rosservice call /varslam/save_map > "$work/save.log" 2>&1 || fail "save_map service"
+grep -q "success: True" "$work/save.log" && [[ -s $work/node.map ]] || fail "save_map did not write the map"
+rosservice call /varslam/localization_only "data: true" > "$work/loc.log" 2>&1 || fail "localization_only service"
+grep -q "success: True" "$work/loc.log" || fail "localization_only refused"
+rosservice call /varslam/reset > "$work/reset.log" 2>&1 || fail "reset service"
+grep -q "success: True" "$work/reset.log" || fail "reset refused"
+rosservice call /varslam/load_map > "$work/load.log" 2>&1 || fail "load_map service"
+grep -q "success: True" "$work/load.log" || fail "load_map refused: $(cat "$work/load.log")"
+
+# rosbag record is a wrapper: its recorder child closes the bag on SIGINT.
+pkill -INT -P "$rec" || true
+kill -INT "$rec" 2>/dev/null || true
+wait "$rec" || true
+for _ in $(seq 50); do [[ -f $work/out.bag ]] && break; sleep 0.1; done
+[[ -f $work/out.bag ]] || fail "rosbag record left no bag: $(ls "$work" | tr "\n" " ")"
+kill -INT "$node"; wait "$node" || fail "the node did not stop cleanly"
+[[ -s $work/stats.json ]] || fail "no stats file"
+
+poses=$(/usr/bin/python3 "$(dirname "$0")/bag_to_tum.py" "$work/out.bag" /varslam/odometry "$work/node.txt")
+tfs=$(/usr/bin/python3 -c "
+import rosbag
+print(sum(1 for _, m, _ in rosbag.Bag('$work/out.bag').read_messages(topics=['/tf'])
+          for t in m.transforms if t.header.frame_id == 'map'))")
+"$bin/varslam" eval --gt "$work/seq/groundtruth.txt" --est "$work/node.txt" --json "$work/node_eval.json" > /dev/null 2>&1
+node_ate=$(/usr/bin/python3 -c "import json; print(json.load(open('$work/node_eval.json'))['ate']['rmse'])")
+echo "node: $poses poses for $frames frames, $tfs TF map -> camera transforms; stats $(cat "$work/stats.json")"
+echo "live ATE: node $node_ate m; direct real-time runs ${ates[*]} m"
+[[ $poses -eq $frames ]] || fail "$poses poses for $frames frames"
+[[ $tfs -eq $frames ]] || fail "$tfs TF map -> camera transforms for $frames frames"
+/usr/bin/python3 - "$node_ate" "${ates[@]}" <<'PY' || fail "node ATE outside the direct runs' spread"
+import sys
+node, runs = float(sys.argv[1]), [float(a) for a in sys.argv[2:]]
+lo, hi = min(runs), max(runs)
+spread = max(hi - lo, 0.002)  # runs can agree to the micrometre; 2 mm is well below what a real-time run varies
+ok = lo - spread <= node <= hi + spread
+print("node %.4f m, direct %.4f..%.4f m, allowed %.4f..%.4f m: %s" % (node, lo, hi, lo - spread, hi + spread, ok))
+sys.exit(0 if ok else 1)
+PY
+echo "node test passed"
