@@ -1,3 +1,4 @@
+#include <cmath>
 #include "cli_common.hpp"
 
 #include <fmt/format.h>
@@ -32,6 +33,25 @@ const std::atomic<bool>& stop_on_signals() {
 
 void wait_for_stop() {
   while (!g_stop_requested.load()) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+}
+
+CLI::Validator finite_range(double lo, double hi, bool lo_open) {
+  return CLI::Validator(
+      [=](std::string& v) -> std::string {
+        double x = 0;
+        std::size_t used = 0;
+        try {
+          x = std::stod(v, &used);
+        } catch (const std::exception&) {
+          return "expected a number, got '" + v + "'";
+        }
+        if (used != v.size()) return "expected a number, got '" + v + "'";
+        if (!std::isfinite(x)) return "expected a finite number, got '" + v + "'";
+        if (x < lo || x > hi || (lo_open && x == lo))
+          return fmt::format("{} is outside {}{}, {}]", v, lo_open ? "(" : "[", lo, hi);
+        return {};
+      },
+      fmt::format("NUMBER in {}{}, {}]", lo_open ? "(" : "[", lo, hi));
 }
 
 void write_report_for_run(const std::filesystem::path& run_dir, const std::filesystem::path& sequence_dir) {

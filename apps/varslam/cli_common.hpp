@@ -1,5 +1,6 @@
 #pragma once
 // Helpers shared by the subcommands: settings overrides from the command line, summary printing.
+#include <CLI/CLI.hpp>
 #include <atomic>
 #include <string>
 #include <vector>
@@ -9,6 +10,10 @@
 #include "run/dataset_run.hpp"
 
 namespace varslam::cli {
+
+/// A number option's check: finite (CLI11's own ranges let NaN through) and within [lo, hi] (or (lo, hi] when
+/// `lo_open`); the error names the value and the range, and CLI11 names the option.
+CLI::Validator finite_range(double lo, double hi, bool lo_open = false);
 
 /// Writes <run>/report.html (plots of the trajectory, error, alpha per keyframe, timings); a failure is a warning.
 void write_report_for_run(const std::filesystem::path& run_dir, const std::filesystem::path& sequence_dir);

@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "bag/bag_from_folder.hpp"
+#include "cli_common.hpp"
 #include "commands.hpp"
 #include "core/error.hpp"
 #include "io/dataset.hpp"
@@ -15,6 +16,7 @@ void add_bag_command(CLI::App& app) {
   struct Opts {
     std::string dataset, settings, out, layout = "tum", images = "raw";
     std::size_t first = 0, max_frames = SIZE_MAX;
+    double time_offset = 0;
     std::vector<std::string> overrides;
   };
   auto o = std::make_shared<Opts>();
@@ -32,6 +34,10 @@ void add_bag_command(CLI::App& app) {
       ->check(CLI::IsMember({"raw", "png", "jpeg"}));
   cmd->add_option("--first", o->first, "First frame index");
   cmd->add_option("--max-frames,-n", o->max_frames, "Write at most this many frames");
+  cmd->add_option("--time-offset", o->time_offset,
+                  "Seconds added to every stamp (ground truth included): a bag cannot hold time 0, which datasets "
+                  "with a clock from 0 (7-Scenes) start at")
+      ->check(finite_range(0.0, 1e9));
   cmd->add_option("--set", o->overrides, "Override a setting: section.key=value (repeatable)");
   cmd->callback([o] {
     if (std::filesystem::path(o->out).extension() != ".bag")
@@ -48,6 +54,7 @@ void add_bag_command(CLI::App& app) {
     wo.images = o->images == "raw" ? bag::BagImages::Raw : o->images == "png" ? bag::BagImages::Png : bag::BagImages::Jpeg;
     wo.first = o->first;
     wo.max_frames = o->max_frames;
+    wo.time_offset = o->time_offset;
     wo.progress = [](std::size_t done, std::size_t total) {
       if (done % 50 == 0 || done == total) std::fprintf(stderr, "\rbag-from-folder: %zu / %zu frames", done, total);
       if (done == total) std::fprintf(stderr, "\n");

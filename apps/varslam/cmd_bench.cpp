@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "cli_common.hpp"
 #include "commands.hpp"
 #include "core/error.hpp"
 #include "report/bench_matrix.hpp"
@@ -57,7 +58,9 @@ void add_bench_command(CLI::App& app) {
                   "NAME@SECONDS fixes the start (default: the window centred in the recording)")
       ->capture_default_str();
   cmd->add_option("--seeds", o->seeds, "Seeds, comma separated")->capture_default_str();
-  cmd->add_option("--seconds", o->b.seconds, "Length of each synthetic sequence")->capture_default_str();
+  cmd->add_option("--seconds", o->b.seconds, "Length of each synthetic sequence")
+      ->capture_default_str()
+      ->check(finite_range(0.0, 3600.0, true));
   cmd->add_option("--configs", o->configs, "Configurations: huber, semantic, kernel, full")->capture_default_str();
   cmd->add_option("--jobs,-j", o->b.jobs, "Parallel child processes (default: number of cores)");
   cmd->add_option("--out,-o", o->b.out, "Output folder")->capture_default_str();
@@ -72,7 +75,8 @@ void add_bench_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--set", o->b.extra_sets, "Extra settings override for every run: section.key=value (repeatable)");
   cmd->add_option("--timeout", o->b.timeout_seconds, "Kill a child process after this many seconds (0: never)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(finite_range(0.0, 1e7));
   cmd->add_flag("--realtime", o->b.realtime, "Run SLAM in real-time mode (default: deterministic)");
   cmd->add_option("--peer", o->b.peer_template,
                   "Peer RGB-D SLAM command run on every sequence, with {dataset} {settings} {out} placeholders "

@@ -22,7 +22,9 @@ void add_demo_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("demo", "Generate a short synthetic dynamic scene and run SLAM on it");
   cmd->add_option("--out,-o", o->out, "Output folder")->capture_default_str();
   cmd->add_option("--scenario", o->scenario, "Synthetic scenario")->capture_default_str();
-  cmd->add_option("--seconds", o->seconds, "Length of the scene")->capture_default_str();
+  cmd->add_option("--seconds", o->seconds, "Length of the scene")
+      ->capture_default_str()
+      ->check(finite_range(0.0, 3600.0, true));
   cmd->add_option("--seed", o->seed, "Random seed")->capture_default_str();
   cmd->add_flag("--realtime", o->realtime, "Real-time mode (threads) instead of deterministic");
   cmd->add_option("--set", o->overrides, "Override a setting: section.key=value (repeatable)");

@@ -4,6 +4,7 @@
 #include <optional>
 #include <string>
 
+#include "cli_common.hpp"
 #include "commands.hpp"
 #include "core/error.hpp"
 #include "eval/eval_report.hpp"
@@ -88,12 +89,16 @@ void add_eval_command(CLI::App& app) {
                   "Write the top view here (.svg or .png) and the error over time as <stem>_ate_error.<ext>");
   cmd->add_option("--max-diff", args->max_diff, "Association window in seconds (strict)")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(finite_range(0.0, 1e6, true));
   cmd->add_option("--map", args->map,
                   "Evaluate in this saved map's alignment to ground truth instead of a fresh one (a run localized in "
                   "the map)");
-  cmd->add_option("--offset", args->offset, "Seconds added to the estimate's timestamps")->capture_default_str();
-  cmd->add_option("--delta", args->delta, "RPE interval in seconds")->capture_default_str()->check(CLI::PositiveNumber);
+  cmd->add_option("--offset", args->offset, "Seconds added to the estimate's timestamps")
+      ->capture_default_str()
+      ->check(finite_range(-1e10, 1e10));
+  cmd->add_option("--delta", args->delta, "RPE interval in seconds")
+      ->capture_default_str()
+      ->check(finite_range(0.0, 1e6, true));
   cmd->add_flag("--scale", args->scale, "Align with scale (Sim(3), for monocular estimates)");
   cmd->add_flag("--per-pair", args->per_pair, "Also put each pair's ATE error into the JSON");
   auto* count = cmd->add_option("--frames", args->frame_count,

@@ -85,7 +85,7 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("--min-tracked-share", o->min_tracked_share,
                   "A run tracking a smaller share of its frames fails (exit 4); 0 accepts any run")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(finite_range(0.0, 1.0));
   cmd->add_option("--save-map", o->save_map, "Write the final map here (docs/map_format.md)");
   cmd->add_option("--load-map", o->load_map, "Start from this saved map: the first frames relocalize in it");
   cmd->add_flag("--localization-only", o->localization_only,
@@ -100,7 +100,7 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("--viewer-fps", o->viewer_fps,
                   "Frames per second sent to the browser at most (lower it when the browser shares a small machine)")
       ->capture_default_str()
-      ->check(CLI::Range(0.5, 60.0));
+      ->check(finite_range(0.5, 60.0));
   cmd->add_flag("--viewer-hold", o->viewer_hold, "Keep the viewer up after the run until Ctrl+C");
   cmd->add_flag("--viewer-wait", o->viewer_wait, "Start the run only once a browser is connected");
   cmd->add_option("--set", o->overrides, "Override a setting: section.key=value (repeatable)");

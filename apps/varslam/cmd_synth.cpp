@@ -4,6 +4,7 @@
 
 #include <cstdio>
 
+#include "cli_common.hpp"
 #include "commands.hpp"
 #include "synth/synth.hpp"
 
@@ -22,19 +23,24 @@ void add_synth_command(CLI::App& app) {
   auto opt = std::make_shared<Options>();
   cmd->add_option("--scenario", opt->cfg.scenario, "static | walking | unknown_box | obstructing_box | balloon | mixed | large_box | large_box_people")
       ->capture_default_str();
-  cmd->add_option("--seconds", opt->cfg.seconds, "Sequence length in seconds")->capture_default_str();
+  cmd->add_option("--seconds", opt->cfg.seconds, "Sequence length in seconds")
+      ->capture_default_str()
+      ->check(finite_range(0.0, 3600.0, true));
   cmd->add_option("--seed", opt->cfg.seed, "Random seed (same seed = identical files)")->capture_default_str();
   cmd->add_option("--path", opt->path, "Camera path: TUM groundtruth file or a folder holding groundtruth.txt "
                                        "(default: built-in real excerpt of TUM fr2/desk_with_person)");
   cmd->add_option("--path-start", opt->cfg.path_start, "Seconds into the path where the sequence starts")
+      ->check(finite_range(0.0, 1e6))
       ->capture_default_str();
   cmd->add_option("--out", opt->out, "Output folder (default: synth_<scenario>_<seed>)");
   cmd->add_flag("--no-preview", opt->no_preview, "Do not write preview.png");
   cmd->add_flag("--hide-movers", opt->hide_movers,
                 "Debug: render the scenario's world without its movers (identical to 'static')");
   cmd->add_option("--box-miss", opt->cfg.box_miss_rate, "Share of person boxes left out, like detector misses")
+      ->check(finite_range(0.0, 1.0))
       ->capture_default_str();
   cmd->add_option("--box-jitter", opt->cfg.box_jitter_px, "Gaussian jitter of person box edges in pixels")
+      ->check(finite_range(0.0, 1000.0))
       ->capture_default_str();
   cmd->add_flag("--list", opt->list, "Print the scenario names and exit");
   cmd->callback([opt] {

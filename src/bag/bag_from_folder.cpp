@@ -81,13 +81,22 @@ BagWriteSummary write_bag_from_dataset(const Dataset& dataset, const Settings& s
   const std::size_t first = std::min(options.first, dataset.size());
   const std::size_t end = first + std::min(options.max_frames, dataset.size() - first);
   if (first == end) throw InputError(fmt::format("{}: no frames to write", dataset.root().string()));
+  // ROS time 0 means "no stamp", and bags refuse it: datasets whose clock starts at 0 need an offset.
+  if (const double t0 = dataset.timestamp(first) + options.time_offset; !(t0 >= 1e-6))
+    throw InputError(fmt::format("{}: the first frame's timestamp is {:.6f} s{}; a ROS bag cannot hold times at or "
+                                 "before 0 (time 0 means 'unset'): give --time-offset 1 (added to every stamp, "
+                                 "ground truth included)",
+                                 dataset.root().string(), dataset.timestamp(first),
+                                 options.time_offset != 0 ? fmt::format(" (with offset {})", options.time_offset)
+                                                          : std::string()));
   if (out.has_parent_path()) fs::create_directories(out.parent_path());
   const fs::path tmp = out.string() + ".partial";
   BagWriteSummary summary;
   summary.info_topic = t.rgb_info;
   {
     bagfile::Writer w(tmp.string());
-    const double t0 = dataset.timestamp(first);
+    const double dt = options.time_offset;
+    const double t0 = dataset.timestamp(first) + dt;
     // The depth unit (metres per raw step) the 16-bit depth needs; 32-bit float depth is metres already.
     const bool raw16 = realsense || options.images != BagImages::Raw;
     if (realsense) w.uint32("/file_version", t0, 3);
@@ -101,7 +110,7 @@ BagWriteSummary write_bag_from_dataset(const Dataset& dataset, const Settings& s
     }
     for (std::size_t i = first; i < end; ++i) {
       const RgbdFrame f = dataset.load(i);
-      const double stamp = f.timestamp;
+      const double stamp = f.timestamp + dt;
       switch (options.images) {
         case BagImages::Raw:
           w.image(rgb_topic, stamp, t.rgb_frame, f.bgr, realsense ? "rgb8" : "bgr8");
@@ -127,7 +136,8 @@ BagWriteSummary write_bag_from_dataset(const Dataset& dataset, const Settings& s
         if (p.timestamp < dataset.timestamp(first) - 1.0 || p.timestamp > dataset.timestamp(end - 1) + 1.0) continue;
         const Eigen::Quaterniond q(p.T_wc.rotation());
         const Eigen::Vector3d x = p.T_wc.translation();
-        w.transform("/tf", {p.timestamp, "world", "kinect", x.x(), x.y(), x.z(), q.x(), q.y(), q.z(), q.w()});
+        if (p.timestamp + dt < 1e-6) continue;
+        w.transform("/tf", {p.timestamp + dt, "world", "kinect", x.x(), x.y(), x.z(), q.x(), q.y(), q.z(), q.w()});
         ++summary.groundtruth_poses;
       }
     }

@@ -17,6 +17,7 @@ struct BagWriteOptions {
   BagLayout layout = BagLayout::Tum;
   BagImages images = BagImages::Raw;
   std::size_t first = 0, max_frames = SIZE_MAX;
+  double time_offset = 0;  // added to every stamp (ground truth included): ROS time 0 means "unset"
   std::function<void(std::size_t done, std::size_t total)> progress;  // optional
 };
 

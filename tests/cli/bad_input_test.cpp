@@ -271,6 +271,24 @@ TEST(BadInput, MapOptionsAreCheckedBeforeTheRun) {
   EXPECT_THAT(missing.output, HasSubstr("/nonexistent/x.map: map file not found"));
 }
 
+// Every number option is finite and in its range, and the error names the option (CLI11's ranges let NaN through).
+TEST(BadInput, NonFiniteOrOutOfRangeNumberOptionsAreRefusedByName) {
+  const std::string seq = base_sequence().string();
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"run -q -d " + seq + " -o " + out_dir("nan_share").string() + " --min-tracked-share nan", "--min-tracked-share"},
+      {"run -q -d " + seq + " -o " + out_dir("nan_fps").string() + " --viewer-fps nan", "--viewer-fps"},
+      {"eval --gt " + seq + "/groundtruth.txt --est " + seq + "/groundtruth.txt --offset nan", "--offset"},
+      {"eval --gt " + seq + "/groundtruth.txt --est " + seq + "/groundtruth.txt --delta -1", "--delta"},
+      {"synth --seconds inf --out " + out_dir("inf_synth").string(), "--seconds"},
+      {"synth --box-miss 2 --out " + out_dir("miss_synth").string(), "--box-miss"},
+      {"bag-from-folder -d " + seq + " -o " + out_path("x.bag").string() + " --time-offset nan", "--time-offset"}};
+  for (const auto& [args, option] : cases) {
+    const Outcome o = cli(args);
+    EXPECT_EQ(o.exit_code, 2) << args << "\n" << o.output;
+    EXPECT_THAT(o.output, HasSubstr(option)) << args;
+  }
+}
+
 // Bags as input (varslam run --dataset FILE.bag): each broken bag is an error naming the bag and what is wrong.
 TEST(BadInput, BadBagsAreNamedErrors) {
   const fs::path dir = out_dir("bags");
