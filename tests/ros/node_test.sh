@@ -25,6 +25,12 @@ unset ROS_HOSTNAME
 "$bin/varslam" bag-from-folder -d "$work/seq" -o "$work/seq.bag" > /dev/null 2>&1
 frames=$(ls "$work/seq/rgb" | wc -l)
 
+# The launch files resolve to the node built here.
+for l in tum realsense; do
+  ROS_PACKAGE_PATH=$build/share roslaunch --args /varslam varslam $l.launch 2>&1 | grep -q "share/varslam/varslam_node" \
+    || fail "$l.launch does not resolve to varslam_node"
+done
+
 # The reference: direct real-time runs of the folder, paced at the frame rate like the bag's playback.
 ates=()
 for i in 1 2 3; do
@@ -47,9 +53,9 @@ set -e
 grep -q "tracking.kernel" "$work/bad.log" || fail "bad parameter: no message naming tracking.kernel"
 grep -q "bogus" "$work/bad.log" || fail "bad parameter: the message does not name the value"
 
-"$bin/varslam_node" __name:=varslam rgb/image:=/camera/rgb/image_color depth/image:=/camera/depth/image \
-  rgb/camera_info:=/camera/rgb/camera_info _semantic/detector:=none _map_file:="$work/node.map" \
-  _stats_file:="$work/stats.json" > "$work/node.log" 2>&1 &
+# The node as a user starts it: the TUM launch file, found through ROS_PACKAGE_PATH (build/share/varslam).
+ROS_PACKAGE_PATH=$build/share roslaunch varslam tum.launch person_detector:=none map_file:="$work/node.map" \
+  stats_file:="$work/stats.json" > "$work/node.log" 2>&1 &
 node=$!
 pids+=($node)
 rosbag record -O "$work/out.bag" /varslam/odometry /tf /varslam/state > "$work/record.log" 2>&1 &
@@ -77,7 +83,8 @@ kill -INT "$rec" 2>/dev/null || true
 wait "$rec" || true
 for _ in $(seq 50); do [[ -f $work/out.bag ]] && break; sleep 0.1; done
 [[ -f $work/out.bag ]] || fail "rosbag record left no bag: $(ls "$work" | tr "\n" " ")"
-kill -INT "$node"; wait "$node" || fail "the node did not stop cleanly"
+kill -INT "$node"; wait "$node" || fail "roslaunch and the node did not stop cleanly"
+for _ in $(seq 100); do [[ -s $work/stats.json ]] && break; sleep 0.1; done
 [[ -s $work/stats.json ]] || fail "no stats file"
 
 poses=$(/usr/bin/python3 "$(dirname "$0")/bag_to_tum.py" "$work/out.bag" /varslam/odometry "$work/node.txt")
