@@ -38,7 +38,7 @@ else()
 endif()
 
 # The node: roscpp, message_filters, cv_bridge and the message headers it publishes.
-pkg_check_modules(ROSNODE QUIET IMPORTED_TARGET roscpp message_filters cv_bridge)
+pkg_check_modules(ROSNODE QUIET IMPORTED_TARGET roscpp message_filters cv_bridge tf2_ros)
 find_path(NAV_MSGS_INCLUDE_DIR nav_msgs/Odometry.h)
 find_path(STD_SRVS_INCLUDE_DIR std_srvs/Trigger.h)
 find_path(VIS_MSGS_INCLUDE_DIR visualization_msgs/MarkerArray.h)
@@ -47,5 +47,5 @@ if(ROSNODE_FOUND AND NAV_MSGS_INCLUDE_DIR AND STD_SRVS_INCLUDE_DIR AND VIS_MSGS_
   message(STATUS "varslam: ROS 1 node on (varslam_node)")
 else()
   message(STATUS "varslam: ROS node off (needs libroscpp-dev, libmessage-filters-dev, libcv-bridge-dev, "
-                 "libnav-msgs-dev, libstd-srvs-dev, libvisualization-msgs-dev)")
+                 "libnav-msgs-dev, libstd-srvs-dev, libvisualization-msgs-dev, libtf2-ros-dev)")
 endif()

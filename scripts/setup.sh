@@ -8,7 +8,8 @@ PKGS=(build-essential cmake pkg-config ccache libopencv-dev libeigen3-dev libcer
       # headers and the ROS 2 helpers they include; ros-core is roscore, python3-rosbag is `rosbag play/reindex`.
       librosbag-storage-dev libroscpp-dev libsensor-msgs-dev libnav-msgs-dev libgeometry-msgs-dev
       libvisualization-msgs-dev libtf2-msgs-dev libstd-msgs-dev libstd-srvs-dev pluginlib-dev libclass-loader-dev
-      librcpputils-dev librcutils-dev libament-index-cpp-dev libmessage-filters-dev libcv-bridge-dev ros-core
+      librcpputils-dev librcutils-dev libament-index-cpp-dev libmessage-filters-dev libcv-bridge-dev libtf2-ros-dev
+      ros-core
       python3-rosbag python3-sensor-msgs
       python3-geometry-msgs python3-nav-msgs python3-tf2-msgs python3-std-srvs)
 # The viewer's build installs three.js with npm; a machine that has node and npm from elsewhere keeps them.

@@ -5,6 +5,7 @@
 #include <geometry_msgs/TransformStamped.h>
 #include <nav_msgs/Odometry.h>
 #include <sensor_msgs/PointCloud2.h>
+#include <tf2/LinearMath/Transform.h>
 #include <sensor_msgs/image_encodings.h>
 #include <sensor_msgs/point_cloud2_iterator.h>
 #include <std_msgs/Float64.h>
@@ -91,6 +92,10 @@ VarslamNode::VarslamNode(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh), pnh
   sync_->registerCallback(boost::bind(&VarslamNode::on_images, this, boost::placeholders::_1, boost::placeholders::_2));
   colour_count_sub_ = nh_.subscribe("rgb/image", 100, &VarslamNode::on_colour_seen, this);
   if (!have_camera_) info_sub_ = nh_.subscribe("rgb/camera_info", 10, &VarslamNode::on_camera_info, this);
+  if (!params_.odom_frame.empty()) {
+    tf_buffer_ = std::make_unique<tf2_ros::Buffer>();
+    tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_, nh_);
+  }
   tracker_ = std::thread([this] { tracking_loop(); });
   ROS_INFO("varslam %s: colour %s, depth %s, camera %s; %s mode", varslam::Slam::version().c_str(),
            rgb_sub_.getTopic().c_str(), depth_sub_.getTopic().c_str(),
@@ -167,6 +172,7 @@ bool VarslamNode::ensure_session(const sensor_msgs::Image& rgb) {
   }
   slam_->add_listener(*this);
   if (params_.camera_frame.empty()) params_.camera_frame = rgb.header.frame_id.empty() ? "camera" : rgb.header.frame_id;
+  if (params_.camera_frame.front() == '/') params_.camera_frame.erase(0, 1);  // tf2 frame ids have no leading '/' 
   if (params_.load_map_at_start) slam_->load_map(params_.map_file);
   if (params_.localization_only) slam_->set_localization_only(true);
   return true;
@@ -206,22 +212,51 @@ void VarslamNode::publish_pose(const varslam::TrackedFrame& f, const std_msgs::H
   odom.child_frame_id = params_.camera_frame;
   odom.pose.pose = to_msg(*f.pose);
   odom_pub_.publish(odom);
-  geometry_msgs::TransformStamped t;
-  t.header = odom.header;
-  t.child_frame_id = params_.camera_frame;
-  t.transform.translation.x = odom.pose.pose.position.x;
-  t.transform.translation.y = odom.pose.pose.position.y;
-  t.transform.translation.z = odom.pose.pose.position.z;
-  t.transform.rotation = odom.pose.pose.orientation;
-  tf2_msgs::TFMessage tf;
-  tf.transforms.push_back(t);
-  tf_pub_.publish(tf);
+  if (const auto t = map_transform(odom)) {
+    tf2_msgs::TFMessage tf;
+    tf.transforms.push_back(*t);
+    tf_pub_.publish(tf);
+  }
   geometry_msgs::PoseStamped ps;
   ps.header = odom.header;
   ps.pose = odom.pose.pose;
   live_path_.header = odom.header;
   live_path_.poses.push_back(ps);
   if (path_pub_.getNumSubscribers() > 0) path_pub_.publish(live_path_);
+}
+
+std::optional<geometry_msgs::TransformStamped> VarslamNode::map_transform(const nav_msgs::Odometry& odom) const {
+  const auto& p = odom.pose.pose;
+  const tf2::Transform map_camera(tf2::Quaternion(p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w),
+                                  tf2::Vector3(p.position.x, p.position.y, p.position.z));
+  tf2::Transform out = map_camera;
+  geometry_msgs::TransformStamped t;
+  t.header = odom.header;
+  t.child_frame_id = params_.camera_frame;
+  if (tf_buffer_) {  // map -> odom = (map -> camera) * (odom -> camera)^-1
+    try {
+      const auto oc = tf_buffer_->lookupTransform(params_.odom_frame, params_.camera_frame, odom.header.stamp,
+                                                  ros::Duration(0.05));
+      const auto& r = oc.transform.rotation;
+      const auto& x = oc.transform.translation;
+      out = map_camera * tf2::Transform(tf2::Quaternion(r.x, r.y, r.z, r.w), tf2::Vector3(x.x, x.y, x.z)).inverse();
+      t.child_frame_id = params_.odom_frame;
+    } catch (const tf2::TransformException& e) {
+      ROS_WARN_THROTTLE(2.0, "no %s -> %s on /tf at %.3f: map -> %s not published (%s)", params_.odom_frame.c_str(),
+                        params_.camera_frame.c_str(), odom.header.stamp.toSec(), params_.odom_frame.c_str(),
+                        e.what());
+      return std::nullopt;
+    }
+  }
+  t.transform.translation.x = out.getOrigin().x();
+  t.transform.translation.y = out.getOrigin().y();
+  t.transform.translation.z = out.getOrigin().z();
+  const tf2::Quaternion q = out.getRotation();
+  t.transform.rotation.x = q.x();
+  t.transform.rotation.y = q.y();
+  t.transform.rotation.z = q.z();
+  t.transform.rotation.w = q.w();
+  return t;
 }
 
 void VarslamNode::publish_map(const ros::Time& stamp) {

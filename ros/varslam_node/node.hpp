@@ -3,7 +3,10 @@
 // odometry, TF, paths, map points, keyframes, tracking state and Local BA alpha out; services to save and load the
 // map, switch localization-only and reset. No SLAM logic here.
 #include <message_filters/subscriber.h>
+#include <geometry_msgs/TransformStamped.h>
+#include <nav_msgs/Odometry.h>
 #include <nav_msgs/Path.h>
+#include <optional>
 #include <message_filters/sync_policies/approximate_time.h>
 #include <message_filters/synchronizer.h>
 #include <ros/ros.h>
@@ -11,6 +14,8 @@
 #include <sensor_msgs/Image.h>
 #include <std_srvs/SetBool.h>
 #include <std_srvs/Trigger.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
 
 #include <atomic>
 #include <chrono>
@@ -48,6 +53,9 @@ class VarslamNode : public varslam::Listener {
   void track(const Pending& p);
   bool ensure_session(const sensor_msgs::Image& rgb);
   void publish_pose(const varslam::TrackedFrame& f, const std_msgs::Header& header);
+  /// The transform the node puts on /tf for a pose: map -> camera, or map -> odom with ~odom_frame (empty when
+  /// odom -> camera is not on /tf at that time).
+  std::optional<geometry_msgs::TransformStamped> map_transform(const nav_msgs::Odometry& odom) const;
   void publish_map(const ros::Time& stamp);
   void publish_corrected_path(const ros::Time& stamp);
   void write_stats() const;
@@ -69,6 +77,9 @@ class VarslamNode : public varslam::Listener {
   ros::Publisher odom_pub_, tf_pub_, path_pub_, corrected_path_pub_, points_pub_, keyframes_pub_, state_pub_,
       alpha_pub_;
   ros::ServiceServer save_srv_, load_srv_, reset_srv_, loc_srv_;
+  // With ~odom_frame: odom -> camera comes from /tf, and map -> odom is what the node publishes.
+  std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
+  std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
 
   // Frames wait here for the tracking thread: the callbacks never wait on SLAM, and no frame is dropped.
   std::mutex queue_mutex_;

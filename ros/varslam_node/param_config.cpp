@@ -8,7 +8,7 @@
 namespace varslam_ros {
 namespace {
 
-const std::set<std::string> kNodeParams = {"settings_file", "map_frame",          "camera_frame",
+const std::set<std::string> kNodeParams = {"settings_file", "map_frame",          "camera_frame",       "odom_frame",
                                            "map_file",      "load_map_at_start",  "localization_only",
                                            "realtime",      "depth_unit",         "map_every_keyframes",
                                            "stats_file"};
@@ -56,6 +56,7 @@ NodeParams read_params(const ros::NodeHandle& pnh, varslam::Config& config) {
   pnh.param("settings_file", p.settings_file, p.settings_file);
   pnh.param("map_frame", p.map_frame, p.map_frame);
   pnh.param("camera_frame", p.camera_frame, p.camera_frame);
+  pnh.param("odom_frame", p.odom_frame, p.odom_frame);
   pnh.param("map_file", p.map_file, p.map_file);
   pnh.param("load_map_at_start", p.load_map_at_start, p.load_map_at_start);
   pnh.param("localization_only", p.localization_only, p.localization_only);

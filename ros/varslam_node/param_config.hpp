@@ -12,6 +12,7 @@ struct NodeParams {
   std::string settings_file;        // ~settings_file: a varslam or ORB-SLAM3 settings file (else CameraInfo)
   std::string map_frame = "map";    // ~map_frame
   std::string camera_frame;         // ~camera_frame (default: the colour image's frame_id)
+  std::string odom_frame;           // ~odom_frame: publish map -> odom (from odom -> camera on /tf), not map -> camera
   std::string map_file;             // ~map_file: what ~save_map writes and ~load_map reads
   bool load_map_at_start = false;   // ~load_map_at_start: start in ~map_file
   bool localization_only = false;   // ~localization_only (with a loaded map)
