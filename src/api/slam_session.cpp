@@ -48,6 +48,10 @@ TrackingState to_state(slam::TrackState s) {
   return TrackingState::Lost;
 }
 
+SessionSummary to_summary(const PipelineSummary& p) {
+  return {p.frames, p.tracked, p.keyframes, p.map_points, p.segments, p.relocalizations, p.detector};
+}
+
 }  // namespace
 
 struct Slam::Impl final : Observer {
@@ -133,7 +137,7 @@ struct Slam::Impl final : Observer {
     {
       std::lock_guard views(views_mutex);
       if (f.pose) live.push_back({t, *f.pose});
-      summary = {p.frames, p.tracked, p.keyframes, p.map_points, p.segments, p.relocalizations, p.detector};
+      summary = to_summary(p);
       snapshot_keyframes = snapshot->keyframes.size();
     }
     // Also when the map changed without a keyframe of this session (a loaded map adopted, keyframes culled).
@@ -210,7 +214,7 @@ void Slam::finish() {
   const PipelineSummary p = impl_->pipeline->summary();
   impl_->refresh_snapshot(p.frames);
   std::lock_guard views(impl_->views_mutex);
-  impl_->summary = {p.frames, p.tracked, p.keyframes, p.map_points, p.segments, p.relocalizations, p.detector};
+  impl_->summary = to_summary(p);
 }
 
 void Slam::reset() {
