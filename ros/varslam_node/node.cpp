@@ -81,6 +81,8 @@ VarslamNode::VarslamNode(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh), pnh
   keyframes_pub_ = pnh_.advertise<visualization_msgs::MarkerArray>("keyframes", 1, true);
   state_pub_ = pnh_.advertise<std_msgs::String>("state", 10);
   alpha_pub_ = pnh_.advertise<std_msgs::Float64>("local_ba_alpha", 10);
+  people_pub_ = pnh_.advertise<visualization_msgs::MarkerArray>("person_boxes", 10);
+  people_sub_ = nh_.subscribe("people", 100, &VarslamNode::on_people, this);
   save_srv_ = pnh_.advertiseService("save_map", &VarslamNode::save_map, this);
   load_srv_ = pnh_.advertiseService("load_map", &VarslamNode::load_map, this);
   reset_srv_ = pnh_.advertiseService("reset", &VarslamNode::reset, this);
@@ -137,6 +139,62 @@ void VarslamNode::on_camera_info(const sensor_msgs::CameraInfoConstPtr& info) {
   queue_cv_.notify_all();
 }
 
+void VarslamNode::on_people(const geometry_msgs::PolygonStampedConstPtr& msg) {
+  std::vector<varslam::PersonBox> boxes;
+  const auto& pts = msg->polygon.points;
+  for (std::size_t i = 0; i + 1 < pts.size(); i += 2)
+    boxes.push_back({pts[i].x, pts[i].y, pts[i + 1].x - pts[i].x, pts[i + 1].y - pts[i].y, pts[i].z});
+  {
+    std::lock_guard<std::mutex> lock(people_mutex_);
+    people_[msg->header.stamp] = std::move(boxes);
+  }
+  people_cv_.notify_all();
+}
+
+std::optional<std::vector<varslam::PersonBox>> VarslamNode::people_for(const ros::Time& stamp) {
+  std::unique_lock<std::mutex> lock(people_mutex_);
+  // Boxes travel on their own topic: give them a moment when someone publishes them.
+  if (people_sub_.getNumPublishers() > 0)
+    people_cv_.wait_for(lock, std::chrono::milliseconds(20), [&] { return people_.count(stamp) > 0; });
+  std::optional<std::vector<varslam::PersonBox>> out;
+  if (const auto it = people_.find(stamp); it != people_.end()) out = it->second;
+  people_.erase(people_.begin(), people_.upper_bound(stamp));  // older stamps will not be asked for again
+  return out;
+}
+
+void VarslamNode::on_person_boxes(const varslam::PersonBoxesInfo& info) {
+  if (people_pub_.getNumSubscribers() == 0) return;
+  // Each box drawn as a rectangle 1 m in front of the camera (the image plane at unit depth), in the camera frame.
+  const double fx = std::stod(config_.get("camera.fx")), fy = std::stod(config_.get("camera.fy"));
+  const double cx = std::stod(config_.get("camera.cx")), cy = std::stod(config_.get("camera.cy"));
+  visualization_msgs::MarkerArray markers;
+  visualization_msgs::Marker m;
+  m.header.stamp = ros::Time(info.timestamp);
+  m.header.frame_id = params_.camera_frame;
+  m.ns = "person_boxes";
+  m.type = visualization_msgs::Marker::LINE_LIST;
+  m.action = visualization_msgs::Marker::ADD;
+  m.pose.orientation.w = 1;
+  m.scale.x = 0.005;
+  m.color.r = 1.0f, m.color.g = 0.3f, m.color.a = 1.0f;
+  m.lifetime = ros::Duration(0.5);
+  auto corner = [&](double u, double v) {
+    geometry_msgs::Point p;
+    p.x = (u - cx) / fx, p.y = (v - cy) / fy, p.z = 1.0;
+    return p;
+  };
+  for (const auto& b : info.boxes) {
+    const geometry_msgs::Point a = corner(b.x, b.y), c = corner(b.x + b.width, b.y + b.height);
+    const geometry_msgs::Point bb = corner(b.x + b.width, b.y), d = corner(b.x, b.y + b.height);
+    for (const auto& [p, q] : {std::pair{a, bb}, std::pair{bb, c}, std::pair{c, d}, std::pair{d, a}}) {
+      m.points.push_back(p);
+      m.points.push_back(q);
+    }
+  }
+  markers.markers.push_back(m);
+  people_pub_.publish(markers);
+}
+
 void VarslamNode::on_images(const sensor_msgs::ImageConstPtr& rgb, const sensor_msgs::ImageConstPtr& depth) {
   {
     std::lock_guard<std::mutex> lock(queue_mutex_);
@@ -183,7 +241,11 @@ void VarslamNode::track(const Pending& p) {
     ensure_session(*p.rgb);
     const cv_bridge::CvImageConstPtr colour = cv_bridge::toCvShare(p.rgb, enc::BGR8);
     const cv::Mat depth = depth_metres(p.depth, params_.depth_unit);
-    const varslam::TrackedFrame f = slam_->track(colour->image, depth, p.rgb->header.stamp.toSec());
+    const auto people = people_for(p.rgb->header.stamp);
+    const double t = p.rgb->header.stamp.toSec();
+    const varslam::TrackedFrame f =
+        people ? slam_->track(colour->image, depth, t, *people) : slam_->track(colour->image, depth, t);
+    if (people) ++stats_.with_people;
     publish_pose(f, p.rgb->header);
     stats_.latency_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - p.received).count());
     if (f.pose) ++stats_.tracked; else ++stats_.lost;
@@ -394,7 +456,7 @@ void VarslamNode::write_stats() const {
   std::ofstream out(params_.stats_file);
   out << "{\"colour_messages\": " << colour_seen_.load() << ", \"synced_pairs\": " << stats_.synced
       << ", \"tracked\": " << stats_.tracked << ", \"lost\": " << stats_.lost << ", \"rejected\": " << stats_.rejected
-      << ", \"max_queue\": " << stats_.max_queue << ", \"latency_ms_median\": " << percentile(stats_.latency_ms, 0.5)
+      << ", \"max_queue\": " << stats_.max_queue << ", \"frames_with_person_boxes\": " << stats_.with_people << ", \"latency_ms_median\": " << percentile(stats_.latency_ms, 0.5)
       << ", \"latency_ms_p95\": " << percentile(stats_.latency_ms, 0.95) << "}\n";
 }
 

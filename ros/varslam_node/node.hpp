@@ -5,6 +5,8 @@
 #include <message_filters/subscriber.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <nav_msgs/Odometry.h>
+#include <geometry_msgs/PolygonStamped.h>
+#include <map>
 #include <nav_msgs/Path.h>
 #include <optional>
 #include <message_filters/sync_policies/approximate_time.h>
@@ -48,6 +50,10 @@ class VarslamNode : public varslam::Listener {
 
   void on_images(const sensor_msgs::ImageConstPtr& rgb, const sensor_msgs::ImageConstPtr& depth);
   void on_camera_info(const sensor_msgs::CameraInfoConstPtr& info);
+  void on_people(const geometry_msgs::PolygonStampedConstPtr& people);
+  /// The person boxes given for this image stamp on `people` (waiting briefly when a publisher exists), if any.
+  std::optional<std::vector<varslam::PersonBox>> people_for(const ros::Time& stamp);
+  void on_person_boxes(const varslam::PersonBoxesInfo& info) override;
   void on_colour_seen(const sensor_msgs::ImageConstPtr&) { ++colour_seen_; }
   void tracking_loop();
   void track(const Pending& p);
@@ -73,9 +79,9 @@ class VarslamNode : public varslam::Listener {
 
   message_filters::Subscriber<sensor_msgs::Image> rgb_sub_, depth_sub_;
   std::unique_ptr<message_filters::Synchronizer<SyncPolicy>> sync_;
-  ros::Subscriber info_sub_, colour_count_sub_;
+  ros::Subscriber info_sub_, colour_count_sub_, people_sub_;
   ros::Publisher odom_pub_, tf_pub_, path_pub_, corrected_path_pub_, points_pub_, keyframes_pub_, state_pub_,
-      alpha_pub_;
+      alpha_pub_, people_pub_;
   ros::ServiceServer save_srv_, load_srv_, reset_srv_, loc_srv_;
   // With ~odom_frame: odom -> camera comes from /tf, and map -> odom is what the node publishes.
   std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
@@ -95,10 +101,15 @@ class VarslamNode : public varslam::Listener {
   nav_msgs::Path live_path_;
   std::size_t keyframes_since_map_ = 0;
   struct Stats {
-    std::size_t synced = 0, tracked = 0, lost = 0, rejected = 0, max_queue = 0;
+    std::size_t synced = 0, tracked = 0, lost = 0, rejected = 0, max_queue = 0, with_people = 0;
     std::vector<double> latency_ms;  // receipt of the pair to the published pose
   } stats_;
   std::atomic<std::size_t> colour_seen_{0};
+  // Person boxes by image stamp, from `people` (geometry_msgs/PolygonStamped: two corners per box, z = score).
+  std::mutex people_mutex_;
+  std::condition_variable people_cv_;
+  std::map<ros::Time, std::vector<varslam::PersonBox>> people_;
+
 };
 
 }  // namespace varslam_ros

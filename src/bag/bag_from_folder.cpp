@@ -7,6 +7,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/error.hpp"
+#include "io/boxes_io.hpp"
 #include "io/trajectory_io.hpp"
 
 #ifdef VARSLAM_HAVE_ROSBAG
@@ -30,19 +31,20 @@ BagWriteSummary write_bag_from_dataset(const Dataset&, const Settings&, const fs
 namespace {
 
 struct LayoutTopics {
-  const char *rgb, *depth, *rgb_info, *depth_info, *depth_units, *rgb_frame, *depth_frame;
+  const char *rgb, *depth, *rgb_info, *depth_info, *depth_units, *rgb_frame, *depth_frame, *people;
 };
 
 constexpr LayoutTopics kTumTopics{"/camera/rgb/image_color", "/camera/depth/image", "/camera/rgb/camera_info",
                                   "/camera/depth/camera_info", "/camera/depth/depth_units",
-                                  "/openni_rgb_optical_frame", "/openni_depth_optical_frame"};
+                                  "/openni_rgb_optical_frame", "/openni_depth_optical_frame", "/camera/rgb/people"};
 constexpr LayoutTopics kRealSenseTopics{"/device_0/sensor_1/Color_0/image/data",
                                         "/device_0/sensor_0/Depth_0/image/data",
                                         "/device_0/sensor_1/Color_0/info/camera_info",
                                         "/device_0/sensor_0/Depth_0/info/camera_info",
                                         "/device_0/sensor_0/option/Depth Units/value",
                                         "camera_color_optical_frame",
-                                        "camera_depth_optical_frame"};
+                                        "camera_depth_optical_frame",
+                                        "/device_0/sensor_1/Color_0/people"};
 constexpr char kRealSenseInfrared[] = "/device_0/sensor_0/Infrared_1/image/data";
 
 // The raw 16-bit depth of a frame: its PNG where the dataset has one, else the metres scaled back.
@@ -108,9 +110,20 @@ BagWriteSummary write_bag_from_dataset(const Dataset& dataset, const Settings& s
       rgb_topic += "/compressed";
       depth_topic += "/compressedDepth";
     }
+    const fs::path boxes_file = dataset.root() / "boxes.txt";
+    const BoxesByTime boxes = fs::is_regular_file(boxes_file) ? read_boxes_file(boxes_file) : BoxesByTime{};
     for (std::size_t i = first; i < end; ++i) {
       const RgbdFrame f = dataset.load(i);
       const double stamp = f.timestamp + dt;
+      if (const Detections people = boxes_near(boxes, f.timestamp, 1e-4); !people.empty()) {  // before the images
+        std::vector<std::array<float, 3>> corners;
+        for (const Detection& d : people) {
+          corners.push_back({d.box.x, d.box.y, d.score});
+          corners.push_back({d.box.x + d.box.width, d.box.y + d.box.height, d.score});
+        }
+        w.polygon(t.people, stamp, t.rgb_frame, corners);
+        ++summary.box_frames;
+      }
       switch (options.images) {
         case BagImages::Raw:
           w.image(rgb_topic, stamp, t.rgb_frame, f.bgr, realsense ? "rgb8" : "bgr8");

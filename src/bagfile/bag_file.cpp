@@ -2,6 +2,7 @@
 
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
+#include <geometry_msgs/PolygonStamped.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/Image.h>
@@ -303,6 +304,20 @@ void Writer::transform(const std::string& topic, const Transform& t) {
   s.transform.rotation.w = t.qw;
   m.transforms.push_back(s);
   impl_->bag.write(topic, s.header.stamp, m);
+}
+
+void Writer::polygon(const std::string& topic, double stamp, const std::string& frame_id,
+                     const std::vector<std::array<float, 3>>& points) {
+  geometry_msgs::PolygonStamped m;
+  m.header = Impl::header(stamp, frame_id);
+  for (const auto& p : points) {
+    geometry_msgs::Point32 q;
+    q.x = p[0];
+    q.y = p[1];
+    q.z = p[2];
+    m.polygon.points.push_back(q);
+  }
+  impl_->bag.write(topic, m.header.stamp, m);
 }
 
 void Writer::float32(const std::string& topic, double stamp, float value) {

@@ -2,6 +2,7 @@
 // ROS 1 bag files read and written through the rosbag storage library, with no ROS type in this header and no ROS
 // master needed. C++17 (ROS 1 message headers do not compile as C++20): the rest of varslam sees only these
 // plain types.
+#include <array>
 #include <cstddef>
 #include <memory>
 #include <optional>
@@ -88,6 +89,9 @@ class Writer {
                   const std::string& format);
   void camera_info(const std::string& topic, double stamp, const CameraInfo& info);
   void transform(const std::string& topic, const Transform& t);  // one tf2_msgs/TFMessage
+  /// geometry_msgs/PolygonStamped: the node's person-box input (two corners per box, z = score).
+  void polygon(const std::string& topic, double stamp, const std::string& frame_id,
+               const std::vector<std::array<float, 3>>& points);
   void float32(const std::string& topic, double stamp, float value);
   void uint32(const std::string& topic, double stamp, unsigned value);
   void close();

@@ -31,10 +31,11 @@ for l in tum realsense; do
     || fail "$l.launch does not resolve to varslam_node"
 done
 
-# The reference: direct real-time runs of the folder, paced at the frame rate like the bag's playback.
+# The reference: direct real-time runs of the folder, paced at the frame rate like the bag's playback, with the
+# same person boxes (the folder's boxes.txt; the node gets them from the bag's people topic).
 ates=()
 for i in 1 2 3; do
-  "$bin/varslam" run -q -d "$work/seq" -o "$work/direct$i" --realtime --pace --set semantic.detector=none \
+  "$bin/varslam" run -q -d "$work/seq" -o "$work/direct$i" --realtime --pace --set semantic.detector=boxes \
     > "$work/direct$i.log" 2>&1 || fail "direct run $i"
   ates+=("$(/usr/bin/python3 -c "import json; print(json.load(open('$work/direct$i/metrics.json'))['ate_live']['rmse'])")")
 done
@@ -58,7 +59,7 @@ ROS_PACKAGE_PATH=$build/share roslaunch varslam tum.launch person_detector:=none
   stats_file:="$work/stats.json" > "$work/node.log" 2>&1 &
 node=$!
 pids+=($node)
-rosbag record -O "$work/out.bag" /varslam/odometry /tf /varslam/state > "$work/record.log" 2>&1 &
+rosbag record -O "$work/out.bag" /varslam/odometry /tf /varslam/state /varslam/person_boxes > "$work/record.log" 2>&1 &
 rec=$!
 pids+=($rec)
 for _ in $(seq 100); do
@@ -97,6 +98,14 @@ node_ate=$(/usr/bin/python3 -c "import json; print(json.load(open('$work/node_ev
 echo "node: $poses poses for $frames frames, $tfs TF map -> camera transforms; stats $(cat "$work/stats.json")"
 echo "live ATE: node $node_ate m; direct real-time runs ${ates[*]} m"
 [[ $poses -eq $frames ]] || fail "$poses poses for $frames frames"
+# The bag's person boxes (geometry_msgs/PolygonStamped on /camera/rgb/people) reached the session, every frame, and
+# came back out as markers.
+box_frames=$(cut -d' ' -f1 "$work/seq/boxes.txt" | grep -v '^#' | sort -u | wc -l)
+with_boxes=$(/usr/bin/python3 -c "import json; print(json.load(open('$work/stats.json'))['frames_with_person_boxes'])")
+markers=$(/usr/bin/python3 -c "import rosbag; print(rosbag.Bag('$work/out.bag').get_message_count('/varslam/person_boxes'))")
+echo "person boxes: $with_boxes frames tracked with the bag's boxes (boxes.txt has $box_frames), $markers marker messages"
+[[ $with_boxes -eq $box_frames && $box_frames -gt 0 ]] || fail "$with_boxes frames with boxes, expected $box_frames"
+[[ $markers -gt 0 ]] || fail "no person box markers"
 [[ $tfs -eq $frames ]] || fail "$tfs TF map -> camera transforms for $frames frames"
 /usr/bin/python3 - "$node_ate" "${ates[@]}" <<'PY' || fail "node ATE outside the direct runs' spread"
 import sys
