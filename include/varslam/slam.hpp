@@ -33,6 +33,15 @@ class Listener {
   virtual void on_person_boxes(const PersonBoxesInfo&) {}
 };
 
+/// The live viewer: a page to open in a browser showing the map, the image with its keypoints, the person boxes and
+/// the Local BA alpha as the session runs (frames are sent only while a browser is connected).
+struct ViewerOptions {
+  int port = 0;                       // 0: a free one
+  std::string address = "127.0.0.1";  // another interface makes the session visible to the network
+  double max_frame_rate = 15;         // frames per second sent at most
+  std::string title;                  // what the page names the run
+};
+
 struct SessionSummary {
   std::size_t frames = 0, tracked = 0, keyframes = 0, map_points = 0;
   int segments = 0, relocalizations = 0;
@@ -48,7 +57,9 @@ class Slam {
   Slam& operator=(const Slam&) = delete;
 
   /// Tracks one frame. Throws InputError for an image of the wrong size or type, or a timestamp that is not
-  /// finite or not after the previous frame's (the frame is then not used; the session goes on).
+  /// finite or not after the previous frame's (the frame is then not used; the session goes on). The session may
+  /// keep the images after the call (the person detector's and the viewer's threads): do not write into them
+  /// afterwards. A matrix over your own buffer (no OpenCV reference count) is copied, so the buffer may be reused.
   TrackedFrame track(const cv::Mat& bgr, const cv::Mat& depth, double timestamp);
   /// The same with the people in this image from the caller's own detector (the person filter uses them as they are).
   TrackedFrame track(const cv::Mat& bgr, const cv::Mat& depth, double timestamp, const std::vector<PersonBox>& people);
@@ -77,6 +88,11 @@ class Slam {
   /// Every tracked frame's pose after every correction so far (Local BA, loops). Tracking thread, or after finish().
   std::vector<TimedPose> camera_trajectory() const;
   SessionSummary summary() const;
+
+  /// Starts the live viewer for this session (it stays up across reset() and load_map()) and returns the address to
+  /// open. InputError when it cannot listen, its page's files are missing, or this build has no viewer. Tracking
+  /// thread.
+  std::string start_viewer(const ViewerOptions& options = {});
 
   /// Not owned; must outlive the session or be removed first. Tracking thread only.
   void add_listener(Listener& listener);

@@ -229,6 +229,17 @@ bool VarslamNode::ensure_session(const sensor_msgs::Image& rgb) {
                                                                        : varslam::Mode::Deterministic);
   }
   slam_->add_listener(*this);
+  if (params_.viewer) {
+    varslam::ViewerOptions v;
+    v.port = params_.viewer_port;
+    v.address = params_.viewer_address;
+    v.title = ros::this_node::getName();
+    try {
+      ROS_INFO("viewer: open %s in a browser", slam_->start_viewer(v).c_str());
+    } catch (const varslam::InputError& e) {
+      ROS_ERROR("viewer not started: %s", e.what());
+    }
+  }
   if (params_.camera_frame.empty()) params_.camera_frame = rgb.header.frame_id.empty() ? "camera" : rgb.header.frame_id;
   if (params_.camera_frame.front() == '/') params_.camera_frame.erase(0, 1);  // tf2 frame ids have no leading '/' 
   if (params_.load_map_at_start) slam_->load_map(params_.map_file);

@@ -11,7 +11,8 @@ namespace {
 const std::set<std::string> kNodeParams = {"settings_file", "map_frame",          "camera_frame",       "odom_frame",
                                            "map_file",      "load_map_at_start",  "localization_only",
                                            "realtime",      "depth_unit",         "map_every_keyframes",
-                                           "stats_file"};
+                                           "stats_file",    "viewer",             "viewer_port",
+                                           "viewer_address"};
 
 std::string as_text(XmlRpc::XmlRpcValue& v, const std::string& name) {
   std::ostringstream s;
@@ -64,6 +65,11 @@ NodeParams read_params(const ros::NodeHandle& pnh, varslam::Config& config) {
   pnh.param("depth_unit", p.depth_unit, p.depth_unit);
   pnh.param("map_every_keyframes", p.map_every_keyframes, p.map_every_keyframes);
   pnh.param("stats_file", p.stats_file, p.stats_file);
+  pnh.param("viewer", p.viewer, p.viewer);
+  pnh.param("viewer_port", p.viewer_port, p.viewer_port);
+  pnh.param("viewer_address", p.viewer_address, p.viewer_address);
+  if (p.viewer_port < 0 || p.viewer_port > 65535)
+    throw varslam::ConfigError("parameter ~viewer_port: " + std::to_string(p.viewer_port) + " is not a port (0-65535)");
   if (!(p.depth_unit > 0 && p.depth_unit < 1))
     throw varslam::ConfigError("parameter ~depth_unit: " + std::to_string(p.depth_unit) +
                                " metres per depth step is not in (0, 1)");

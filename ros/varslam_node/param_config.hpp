@@ -20,6 +20,9 @@ struct NodeParams {
   double depth_unit = 0.001;        // ~depth_unit: metres per step of 16-bit depth (REP 118: millimetres)
   int map_every_keyframes = 1;      // ~map_every_keyframes: publish the map points every N keyframes
   std::string stats_file;           // ~stats_file: JSON written at shutdown (frames, drops, latency)
+  bool viewer = false;              // ~viewer: serve the live viewer (its address is logged)
+  int viewer_port = 0;              // ~viewer_port (0: a free one)
+  std::string viewer_address = "127.0.0.1";  // ~viewer_address
 };
 
 /// Reads the node's parameters and applies every other private parameter to `config` as a setting. Throws

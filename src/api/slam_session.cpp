@@ -15,6 +15,9 @@
 #include "slam/keyframe.hpp"
 #include "slam/map.hpp"
 #include "slam/map_point.hpp"
+#ifdef VARSLAM_HAVE_VIEWER
+#include "viewer/live_viewer.hpp"
+#endif
 
 namespace varslam {
 namespace detail {
@@ -59,6 +62,9 @@ struct Slam::Impl final : Observer {
   Mode mode;
   std::optional<std::string> map_file;  // loaded again by reset()
   bool localization_only = false;
+#ifdef VARSLAM_HAVE_VIEWER
+  std::unique_ptr<viewer::LiveViewer> viewer;  // before the pipeline: it observes it, so it must outlive it
+#endif
   std::unique_ptr<Pipeline> pipeline;
   std::vector<Listener*> listeners;
 
@@ -86,6 +92,9 @@ struct Slam::Impl final : Observer {
     if (!map_file) localization_only = false;  // a new session without a map has nothing to localize in
     if (localization_only) p->set_localization_only(true);
     p->add_observer(*this);
+#ifdef VARSLAM_HAVE_VIEWER
+    if (viewer) p->add_observer(*viewer);
+#endif
     pipeline = std::move(p);
     last_timestamp.reset();
     std::lock_guard lock(views_mutex);
@@ -116,7 +125,11 @@ struct Slam::Impl final : Observer {
     std::lock_guard lock(pipeline_mutex);
     check_timestamp(t);
     relocalized_now = false;
-    const FrameResult r = pipeline->track(bgr, depth, t, boxes);
+    // The detector and the viewer may hold the images after this call: a matrix that wraps the caller's buffer
+    // (no reference count: cv_bridge's toCvShare, a Mat over a camera driver's memory) is copied first.
+    const cv::Mat own_bgr = bgr.u ? bgr : bgr.clone();
+    const cv::Mat own_depth = depth.u ? depth : depth.clone();
+    const FrameResult r = pipeline->track(own_bgr, own_depth, t, boxes);
     last_timestamp = t;
     TrackedFrame f;
     f.index = r.index;
@@ -267,6 +280,27 @@ std::vector<TimedPose> Slam::camera_trajectory() const {
 SessionSummary Slam::summary() const {
   std::lock_guard lock(impl_->views_mutex);
   return impl_->summary;
+}
+
+std::string Slam::start_viewer(const ViewerOptions& options) {
+#ifdef VARSLAM_HAVE_VIEWER
+  std::lock_guard lock(impl_->pipeline_mutex);
+  if (impl_->viewer) return impl_->viewer->url();
+  if (!std::isfinite(options.max_frame_rate) || options.max_frame_rate <= 0 || options.port < 0 || options.port > 65535)
+    throw InputError(fmt::format("viewer: port {} or frame rate {} out of range (0-65535, > 0)", options.port,
+                                 options.max_frame_rate));
+  viewer::LiveViewerOptions vo;
+  vo.server.address = options.address;
+  vo.server.port = options.port;
+  vo.max_frame_rate = options.max_frame_rate;
+  vo.title = options.title;
+  impl_->viewer = std::make_unique<viewer::LiveViewer>(vo);
+  impl_->pipeline->add_observer(*impl_->viewer);
+  return impl_->viewer->url();
+#else
+  (void)options;
+  throw InputError("viewer: this varslam was built without the viewer (-DVARSLAM_BUILD_VIEWER=OFF)");
+#endif
 }
 
 void Slam::add_listener(Listener& l) { impl_->listeners.push_back(&l); }

@@ -12,6 +12,9 @@
 
 #include "io/dataset.hpp"
 #include "slam/e2e_support.hpp"
+#ifdef VARSLAM_HAVE_VIEWER
+#include <httplib.h>  // after Eigen: it defines names Eigen's headers use
+#endif
 
 namespace {
 
@@ -155,6 +158,32 @@ TEST(ApiSlam, ASessionWritesNothingToStandardOutput) {
   }
   EXPECT_EQ(::testing::internal::GetCapturedStdout(), "");
 }
+
+#ifdef VARSLAM_HAVE_VIEWER
+TEST(ApiSlam, TheLiveViewerServesItsPageAndStaysUpAcrossAReset) {
+  varslam::Slam slam(sequence().config);
+  const std::string url = slam.start_viewer({});
+  ASSERT_EQ(url.rfind("http://127.0.0.1:", 0), 0u) << url;
+  const int port = std::stoi(url.substr(url.rfind(':') + 1));
+  EXPECT_EQ(slam.start_viewer({}), url);  // one viewer per session
+  for (std::size_t i = 0; i < 5; ++i)
+    slam.track(sequence().frames[i].bgr, sequence().frames[i].depth, sequence().frames[i].timestamp);
+  httplib::Client c("127.0.0.1", port);
+  auto page = c.Get("/");
+  ASSERT_TRUE(page);
+  EXPECT_EQ(page->status, 200);
+  EXPECT_THAT(page->body, HasSubstr("<html"));
+  slam.reset();
+  slam.track(sequence().frames[5].bgr, sequence().frames[5].depth, sequence().frames[5].timestamp);
+  page = c.Get("/");
+  ASSERT_TRUE(page);
+  EXPECT_EQ(page->status, 200);
+  varslam::ViewerOptions taken;
+  taken.port = port;
+  varslam::Slam other(sequence().config);
+  EXPECT_THAT(input_error([&] { other.start_viewer(taken); }), HasSubstr(std::to_string(port)));
+}
+#endif
 
 TEST(ApiLog, TheCallersSinkGetsTheLines) {
   std::vector<std::string> lines;

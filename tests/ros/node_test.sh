@@ -56,7 +56,7 @@ grep -q "bogus" "$work/bad.log" || fail "bad parameter: the message does not nam
 
 # The node as a user starts it: the TUM launch file, found through ROS_PACKAGE_PATH (build/share/varslam).
 ROS_PACKAGE_PATH=$build/share roslaunch varslam tum.launch person_detector:=none map_file:="$work/node.map" \
-  stats_file:="$work/stats.json" > "$work/node.log" 2>&1 &
+  stats_file:="$work/stats.json" viewer:=true > "$work/node.log" 2>&1 &
 node=$!
 pids+=($node)
 rosbag record -O "$work/out.bag" /varslam/odometry /tf /varslam/state /varslam/person_boxes > "$work/record.log" 2>&1 &
@@ -66,7 +66,15 @@ for _ in $(seq 100); do
   rosservice list 2>/dev/null | grep -q /varslam/save_map && rostopic info /varslam/odometry 2>/dev/null | grep -q record && break
   sleep 0.2
 done
-rosbag play -q "$work/seq.bag" > "$work/play.log" 2>&1 || fail "rosbag play"
+rosbag play -q "$work/seq.bag" > "$work/play.log" 2>&1 &
+play=$!
+# The live viewer from the node: a client on its event stream makes it encode frames while the bag plays.
+for _ in $(seq 50); do grep -q 'viewer: open http' "$work/node.log" && break; sleep 0.1; done
+viewer_url=$(grep 'viewer: open' "$work/node.log" | grep -o 'http://127.0.0.1:[0-9]*/' | head -1)
+[[ -n $viewer_url ]] || fail "the node did not say where its viewer is"
+curl -s -N --max-time 3 "${viewer_url}events" > "$work/events.txt" || true
+wait "$play" || fail "rosbag play"
+grep -q '^event: frame' "$work/events.txt" || fail "the viewer sent no frame: $(head -c 300 "$work/events.txt")"
 sleep 2  # the last frames through tracking and publishing
 
 rosservice call /varslam/save_map > "$work/save.log" 2>&1 || fail "save_map service"
