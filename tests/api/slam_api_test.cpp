@@ -10,6 +10,7 @@
 #include <thread>
 #include <varslam/varslam.hpp>
 
+#include "bag/bag_from_folder.hpp"
 #include "io/dataset.hpp"
 #include "slam/e2e_support.hpp"
 #ifdef VARSLAM_HAVE_VIEWER
@@ -184,6 +185,39 @@ TEST(ApiSlam, TheLiveViewerServesItsPageAndStaysUpAcrossAReset) {
   EXPECT_THAT(input_error([&] { other.start_viewer(taken); }), HasSubstr(std::to_string(port)));
 }
 #endif
+
+TEST(ApiBag, ABagReadThroughTheLibraryTracksLikeItsFolder) {
+  if (!varslam::BagReader::supported()) GTEST_SKIP() << "built without ROS bag support";
+  const fs::path dir = varslam::slam::e2e::pipeline_walking_sequence();
+  const fs::path out = fs::temp_directory_path() / ("varslam_api_bag_" + std::to_string(::getpid()));
+  fs::remove_all(out);
+  const varslam::Settings folder = varslam::settings_for_dataset(dir, std::nullopt);
+  const auto ds = varslam::open_dataset(dir, folder);
+  varslam::bag::write_bag_from_dataset(*ds, folder, out / "seq.bag", {});
+  varslam::BagTopics topics;
+  topics.gt_frame = "kinect";
+  EXPECT_EQ(varslam::BagReader((out / "seq.bag").string()).config().get("camera.fx"),
+            sequence().config.get("camera.fx"));  // from CameraInfo
+  // With the folder's settings file (CameraInfo has no depth baseline), the same session as on the folder.
+  const varslam::BagReader bag((out / "seq.bag").string(), topics, (dir / "settings.yaml").string());
+  ASSERT_EQ(bag.size(), sequence().frames.size());
+  EXPECT_EQ(bag.groundtruth().size(), bag.size());
+  varslam::Config config = bag.config();
+  config.set("semantic.detector", "none");
+  varslam::Slam from_bag(config), from_folder(sequence().config);
+  for (std::size_t i = 0; i < bag.size(); ++i) {
+    const varslam::BagFrame f = bag.frame(i);
+    const auto& g = sequence().frames[i];
+    ASSERT_EQ(f.timestamp, g.timestamp);
+    const auto a = from_bag.track(f.bgr, f.depth, f.timestamp), b = from_folder.track(g.bgr, g.depth, g.timestamp);
+    ASSERT_EQ(a.pose.has_value(), b.pose.has_value());
+    if (a.pose) {
+      EXPECT_EQ(a.pose->translation, b.pose->translation) << i;
+    }
+  }
+  EXPECT_THAT(input_error([&] { varslam::BagReader((out / "none.bag").string()); }), HasSubstr("does not exist"));
+  fs::remove_all(out);
+}
 
 TEST(ApiLog, TheCallersSinkGetsTheLines) {
   std::vector<std::string> lines;

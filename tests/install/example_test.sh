@@ -30,11 +30,14 @@ struct Camera { int users_own_camera = 1; };
 HPP
 cat > "$work/clash/main.cpp" <<'CPP'
 #include "core/camera.hpp"
+#include <cstdio>
 #include <varslam/varslam.hpp>
 int main() {
   Camera c;
   varslam::Config config;
   config.set("camera.fx", 600.0);
+  const bool bags = varslam::BagReader::supported();  // links the bag reader (and ROS, where it was built)
+  std::printf("bags %s\n", bags ? "supported" : "not supported");
   return (c.users_own_camera == 1 && config.get("camera.fx") == "600") ? 0 : 1;
 }
 CPP
