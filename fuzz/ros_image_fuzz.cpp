@@ -10,7 +10,8 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace varslam;
-  static const std::array<const char*, 8> kRaw = {"rgb8", "bgr8", "rgba8", "mono8", "16UC1", "mono16", "32FC1", "yuv422"};
+  static const std::array<const char*, 8> kRaw = {"rgb8",  "bgr8",   "rgba8", "mono8",
+                                                  "16UC1", "mono16", "32FC1", "yuv422"};
   static const std::array<const char*, 4> kCompressed = {"jpeg", "bgr8; png compressed bgr8",
                                                          "16UC1; compressedDepth png", "32FC1; compressedDepth"};
   if (size < 4) return 0;

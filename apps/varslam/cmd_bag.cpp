@@ -24,12 +24,14 @@ void add_bag_command(CLI::App& app) {
   cmd->add_option("--dataset,-d", o->dataset, "Dataset folder (TUM/Bonn/OpenLORIS layout)")->required();
   cmd->add_option("--out,-o", o->out, "The bag to write (.bag)")->required();
   cmd->add_option("--settings,-s", o->settings, "Settings YAML (default: <dataset>/settings.yaml): the CameraInfo");
-  cmd->add_option("--layout", o->layout, "Topic layout: tum (/camera/rgb/image_color, ...) or realsense "
-                                         "(/device_0/sensor_*/..., with the depth unit and an infrared stream)")
+  cmd->add_option("--layout", o->layout,
+                  "Topic layout: tum (/camera/rgb/image_color, ...) or realsense "
+                  "(/device_0/sensor_*/..., with the depth unit and an infrared stream)")
       ->capture_default_str()
       ->check(CLI::IsMember({"tum", "realsense"}));
-  cmd->add_option("--images", o->images, "raw (sensor_msgs/Image), png (CompressedImage, lossless: colour PNG and "
-                                         "compressedDepth PNG) or jpeg (colour JPEG, lossy; depth compressedDepth PNG)")
+  cmd->add_option("--images", o->images,
+                  "raw (sensor_msgs/Image), png (CompressedImage, lossless: colour PNG and "
+                  "compressedDepth PNG) or jpeg (colour JPEG, lossy; depth compressedDepth PNG)")
       ->capture_default_str()
       ->check(CLI::IsMember({"raw", "png", "jpeg"}));
   cmd->add_option("--first", o->first, "First frame index");
@@ -51,7 +53,9 @@ void add_bag_command(CLI::App& app) {
     const auto dataset = open_dataset(o->dataset, settings);
     bag::BagWriteOptions wo;
     wo.layout = o->layout == "tum" ? bag::BagLayout::Tum : bag::BagLayout::RealSense;
-    wo.images = o->images == "raw" ? bag::BagImages::Raw : o->images == "png" ? bag::BagImages::Png : bag::BagImages::Jpeg;
+    wo.images = o->images == "raw"   ? bag::BagImages::Raw
+                : o->images == "png" ? bag::BagImages::Png
+                                     : bag::BagImages::Jpeg;
     wo.first = o->first;
     wo.max_frames = o->max_frames;
     wo.time_offset = o->time_offset;
@@ -60,9 +64,10 @@ void add_bag_command(CLI::App& app) {
       if (done == total) std::fprintf(stderr, "\n");
     };
     const bag::BagWriteSummary s = bag::write_bag_from_dataset(*dataset, settings, o->out, wo);
-    fmt::print("bag-from-folder: {} frames -> {} (colour {}, depth {}, camera {}, {} ground-truth poses in /tf as "
-               "world -> kinect)\n",
-               s.frames, o->out, s.rgb_topic, s.depth_topic, s.info_topic, s.groundtruth_poses);
+    fmt::print(
+        "bag-from-folder: {} frames -> {} (colour {}, depth {}, camera {}, {} ground-truth poses in /tf as "
+        "world -> kinect)\n",
+        s.frames, o->out, s.rgb_topic, s.depth_topic, s.info_topic, s.groundtruth_poses);
   });
 }
 

@@ -5,16 +5,16 @@
 //
 //   varslam::BagReader bag("walking.bag");
 //   varslam::Slam slam(bag.config());
-//   for (std::size_t i = 0; i < bag.size(); ++i) { const auto f = bag.frame(i); slam.track(f.bgr, f.depth, f.timestamp); }
+//   for (std::size_t i = 0; i < bag.size(); ++i) { const auto f = bag.frame(i); slam.track(f.bgr, f.depth,
+//   f.timestamp); }
 #include <cstddef>
 #include <memory>
-#include <string>
-#include <vector>
-
 #include <opencv2/core/mat.hpp>
+#include <string>
 #include <varslam/config.hpp>
 #include <varslam/error.hpp>
 #include <varslam/types.hpp>
+#include <vector>
 
 namespace varslam {
 

@@ -4,9 +4,8 @@
 // type, NaN or out of range is a ConfigError naming the key (and the file and line when it came from a file).
 #include <memory>
 #include <string>
-#include <vector>
-
 #include <varslam/error.hpp>
+#include <vector>
 
 namespace varslam {
 

@@ -7,14 +7,13 @@
 // live_trajectory(), save_map(), summary(). Listener callbacks run on the tracking thread, inside track() or
 // finish(); they must not call back into the session.
 #include <memory>
+#include <opencv2/core/mat.hpp>
 #include <optional>
 #include <string>
-#include <vector>
-
-#include <opencv2/core/mat.hpp>
 #include <varslam/config.hpp>
 #include <varslam/error.hpp>
 #include <varslam/types.hpp>
+#include <vector>
 
 namespace varslam {
 

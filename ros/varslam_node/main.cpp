@@ -10,10 +10,18 @@ int main(int argc, char** argv) {
   varslam::set_log_sink(
       [](varslam::LogLevel level, const std::string& line) {
         switch (level) {
-          case varslam::LogLevel::Error: ROS_ERROR("%s", line.c_str()); break;
-          case varslam::LogLevel::Warn: ROS_WARN("%s", line.c_str()); break;
-          case varslam::LogLevel::Info: ROS_INFO("%s", line.c_str()); break;
-          default: ROS_DEBUG("%s", line.c_str()); break;
+          case varslam::LogLevel::Error:
+            ROS_ERROR("%s", line.c_str());
+            break;
+          case varslam::LogLevel::Warn:
+            ROS_WARN("%s", line.c_str());
+            break;
+          case varslam::LogLevel::Info:
+            ROS_INFO("%s", line.c_str());
+            break;
+          default:
+            ROS_DEBUG("%s", line.c_str());
+            break;
         }
       },
       varslam::LogLevel::Info);

@@ -1,19 +1,19 @@
 #include "node.hpp"
 
-#include <boost/bind/bind.hpp>
 #include <cv_bridge/cv_bridge.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <nav_msgs/Odometry.h>
 #include <sensor_msgs/PointCloud2.h>
-#include <tf2/LinearMath/Transform.h>
 #include <sensor_msgs/image_encodings.h>
 #include <sensor_msgs/point_cloud2_iterator.h>
 #include <std_msgs/Float64.h>
 #include <std_msgs/String.h>
+#include <tf2/LinearMath/Transform.h>
 #include <tf2_msgs/TFMessage.h>
 #include <visualization_msgs/MarkerArray.h>
 
 #include <algorithm>
+#include <boost/bind/bind.hpp>
 #include <cstdio>
 #include <fstream>
 #include <future>
@@ -38,9 +38,12 @@ geometry_msgs::Pose to_msg(const varslam::Pose& p) {
 
 const char* state_name(varslam::TrackingState s) {
   switch (s) {
-    case varslam::TrackingState::Tracking: return "tracking";
-    case varslam::TrackingState::Lost: return "lost";
-    case varslam::TrackingState::NotInitialized: return "not_initialized";
+    case varslam::TrackingState::Tracking:
+      return "tracking";
+    case varslam::TrackingState::Lost:
+      return "lost";
+    case varslam::TrackingState::NotInitialized:
+      return "not_initialized";
   }
   return "unknown";
 }
@@ -225,8 +228,8 @@ bool VarslamNode::ensure_session(const sensor_msgs::Image& rgb) {
   if (slam_) return true;
   {
     std::lock_guard<std::mutex> lock(queue_mutex_);
-    slam_ = std::make_unique<varslam::Slam>(config_, params_.realtime ? varslam::Mode::RealTime
-                                                                       : varslam::Mode::Deterministic);
+    slam_ = std::make_unique<varslam::Slam>(config_,
+                                            params_.realtime ? varslam::Mode::RealTime : varslam::Mode::Deterministic);
   }
   slam_->add_listener(*this);
   if (params_.viewer) {
@@ -241,7 +244,7 @@ bool VarslamNode::ensure_session(const sensor_msgs::Image& rgb) {
     }
   }
   if (params_.camera_frame.empty()) params_.camera_frame = rgb.header.frame_id.empty() ? "camera" : rgb.header.frame_id;
-  if (params_.camera_frame.front() == '/') params_.camera_frame.erase(0, 1);  // tf2 frame ids have no leading '/' 
+  if (params_.camera_frame.front() == '/') params_.camera_frame.erase(0, 1);  // tf2 frame ids have no leading '/'
   if (params_.load_map_at_start) slam_->load_map(params_.map_file);
   if (params_.localization_only) slam_->set_localization_only(true);
   return true;
@@ -259,7 +262,10 @@ void VarslamNode::track(const Pending& p) {
     if (people) ++stats_.with_people;
     publish_pose(f, p.rgb->header);
     stats_.latency_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - p.received).count());
-    if (f.pose) ++stats_.tracked; else ++stats_.lost;
+    if (f.pose)
+      ++stats_.tracked;
+    else
+      ++stats_.lost;
     if (f.keyframe && ++keyframes_since_map_ >= static_cast<std::size_t>(params_.map_every_keyframes)) {
       keyframes_since_map_ = 0;
       publish_map(p.rgb->header.stamp);
@@ -308,16 +314,15 @@ std::optional<geometry_msgs::TransformStamped> VarslamNode::map_transform(const 
   t.child_frame_id = params_.camera_frame;
   if (tf_buffer_) {  // map -> odom = (map -> camera) * (odom -> camera)^-1
     try {
-      const auto oc = tf_buffer_->lookupTransform(params_.odom_frame, params_.camera_frame, odom.header.stamp,
-                                                  ros::Duration(0.05));
+      const auto oc =
+          tf_buffer_->lookupTransform(params_.odom_frame, params_.camera_frame, odom.header.stamp, ros::Duration(0.05));
       const auto& r = oc.transform.rotation;
       const auto& x = oc.transform.translation;
       out = map_camera * tf2::Transform(tf2::Quaternion(r.x, r.y, r.z, r.w), tf2::Vector3(x.x, x.y, x.z)).inverse();
       t.child_frame_id = params_.odom_frame;
     } catch (const tf2::TransformException& e) {
       ROS_WARN_THROTTLE(2.0, "no %s -> %s on /tf at %.3f: map -> %s not published (%s)", params_.odom_frame.c_str(),
-                        params_.camera_frame.c_str(), odom.header.stamp.toSec(), params_.odom_frame.c_str(),
-                        e.what());
+                        params_.camera_frame.c_str(), odom.header.stamp.toSec(), params_.odom_frame.c_str(), e.what());
       return std::nullopt;
     }
   }
@@ -467,7 +472,8 @@ void VarslamNode::write_stats() const {
   std::ofstream out(params_.stats_file);
   out << "{\"colour_messages\": " << colour_seen_.load() << ", \"synced_pairs\": " << stats_.synced
       << ", \"tracked\": " << stats_.tracked << ", \"lost\": " << stats_.lost << ", \"rejected\": " << stats_.rejected
-      << ", \"max_queue\": " << stats_.max_queue << ", \"frames_with_person_boxes\": " << stats_.with_people << ", \"latency_ms_median\": " << percentile(stats_.latency_ms, 0.5)
+      << ", \"max_queue\": " << stats_.max_queue << ", \"frames_with_person_boxes\": " << stats_.with_people
+      << ", \"latency_ms_median\": " << percentile(stats_.latency_ms, 0.5)
       << ", \"latency_ms_p95\": " << percentile(stats_.latency_ms, 0.95) << "}\n";
 }
 

@@ -2,15 +2,13 @@
 // varslam as a ROS 1 node: a thin adapter over the public API (varslam::Slam). Synchronised colour + depth in,
 // odometry, TF, paths, map points, keyframes, tracking state and Local BA alpha out; services to save and load the
 // map, switch localization-only and reset. No SLAM logic here.
-#include <message_filters/subscriber.h>
-#include <geometry_msgs/TransformStamped.h>
-#include <nav_msgs/Odometry.h>
 #include <geometry_msgs/PolygonStamped.h>
-#include <map>
-#include <nav_msgs/Path.h>
-#include <optional>
+#include <geometry_msgs/TransformStamped.h>
+#include <message_filters/subscriber.h>
 #include <message_filters/sync_policies/approximate_time.h>
 #include <message_filters/synchronizer.h>
+#include <nav_msgs/Odometry.h>
+#include <nav_msgs/Path.h>
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
@@ -23,8 +21,10 @@
 #include <chrono>
 #include <condition_variable>
 #include <deque>
+#include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <thread>
 #include <varslam/varslam.hpp>
 
@@ -93,7 +93,7 @@ class VarslamNode : public varslam::Listener {
   std::deque<Pending> queue_;
   bool stop_ = false;
   std::thread tracker_;
-  std::mutex session_mutex_;  // held by the tracking thread for each frame, and by the services
+  std::mutex session_mutex_;              // held by the tracking thread for each frame, and by the services
   std::atomic<int> services_waiting_{0};  // the tracking thread lets a waiting service in before its next frame
   std::unique_lock<std::mutex> lock_for_service();
 
@@ -109,7 +109,6 @@ class VarslamNode : public varslam::Listener {
   std::mutex people_mutex_;
   std::condition_variable people_cv_;
   std::map<ros::Time, std::vector<varslam::PersonBox>> people_;
-
 };
 
 }  // namespace varslam_ros

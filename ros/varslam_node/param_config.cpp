@@ -8,22 +8,24 @@
 namespace varslam_ros {
 namespace {
 
-const std::set<std::string> kNodeParams = {"settings_file", "map_frame",          "camera_frame",       "odom_frame",
-                                           "map_file",      "load_map_at_start",  "localization_only",
-                                           "realtime",      "depth_unit",         "map_every_keyframes",
-                                           "stats_file",    "viewer",             "viewer_port",
-                                           "viewer_address"};
+const std::set<std::string> kNodeParams = {"settings_file", "map_frame",           "camera_frame",      "odom_frame",
+                                           "map_file",      "load_map_at_start",   "localization_only", "realtime",
+                                           "depth_unit",    "map_every_keyframes", "stats_file",        "viewer",
+                                           "viewer_port",   "viewer_address"};
 
 std::string as_text(XmlRpc::XmlRpcValue& v, const std::string& name) {
   std::ostringstream s;
   switch (v.getType()) {
-    case XmlRpc::XmlRpcValue::TypeBoolean: return static_cast<bool>(v) ? "true" : "false";
-    case XmlRpc::XmlRpcValue::TypeInt: return std::to_string(static_cast<int>(v));
+    case XmlRpc::XmlRpcValue::TypeBoolean:
+      return static_cast<bool>(v) ? "true" : "false";
+    case XmlRpc::XmlRpcValue::TypeInt:
+      return std::to_string(static_cast<int>(v));
     case XmlRpc::XmlRpcValue::TypeDouble:
       s.precision(17);
       s << static_cast<double>(v);
       return s.str();
-    case XmlRpc::XmlRpcValue::TypeString: return static_cast<std::string>(v);
+    case XmlRpc::XmlRpcValue::TypeString:
+      return static_cast<std::string>(v);
     default:
       throw varslam::ConfigError("parameter " + name + ": a setting takes a number, a boolean or a string");
   }

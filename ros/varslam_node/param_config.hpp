@@ -9,19 +9,19 @@
 namespace varslam_ros {
 
 struct NodeParams {
-  std::string settings_file;        // ~settings_file: a varslam or ORB-SLAM3 settings file (else CameraInfo)
-  std::string map_frame = "map";    // ~map_frame
-  std::string camera_frame;         // ~camera_frame (default: the colour image's frame_id)
-  std::string odom_frame;           // ~odom_frame: publish map -> odom (from odom -> camera on /tf), not map -> camera
-  std::string map_file;             // ~map_file: what ~save_map writes and ~load_map reads
-  bool load_map_at_start = false;   // ~load_map_at_start: start in ~map_file
-  bool localization_only = false;   // ~localization_only (with a loaded map)
-  bool realtime = true;             // ~realtime: false = deterministic (every stage in the tracking thread)
-  double depth_unit = 0.001;        // ~depth_unit: metres per step of 16-bit depth (REP 118: millimetres)
-  int map_every_keyframes = 1;      // ~map_every_keyframes: publish the map points every N keyframes
-  std::string stats_file;           // ~stats_file: JSON written at shutdown (frames, drops, latency)
-  bool viewer = false;              // ~viewer: serve the live viewer (its address is logged)
-  int viewer_port = 0;              // ~viewer_port (0: a free one)
+  std::string settings_file;       // ~settings_file: a varslam or ORB-SLAM3 settings file (else CameraInfo)
+  std::string map_frame = "map";   // ~map_frame
+  std::string camera_frame;        // ~camera_frame (default: the colour image's frame_id)
+  std::string odom_frame;          // ~odom_frame: publish map -> odom (from odom -> camera on /tf), not map -> camera
+  std::string map_file;            // ~map_file: what ~save_map writes and ~load_map reads
+  bool load_map_at_start = false;  // ~load_map_at_start: start in ~map_file
+  bool localization_only = false;  // ~localization_only (with a loaded map)
+  bool realtime = true;            // ~realtime: false = deterministic (every stage in the tracking thread)
+  double depth_unit = 0.001;       // ~depth_unit: metres per step of 16-bit depth (REP 118: millimetres)
+  int map_every_keyframes = 1;     // ~map_every_keyframes: publish the map points every N keyframes
+  std::string stats_file;          // ~stats_file: JSON written at shutdown (frames, drops, latency)
+  bool viewer = false;             // ~viewer: serve the live viewer (its address is logged)
+  int viewer_port = 0;             // ~viewer_port (0: a free one)
   std::string viewer_address = "127.0.0.1";  // ~viewer_address
 };
 

@@ -58,7 +58,8 @@ std::string Config::get(const std::string& key) const {
     if (k.name == key) spec = &k;
   if (!spec) {
     const std::string near = nearest_key(key);
-    throw ConfigError(fmt::format("unknown settings key '{}'{}", key, near.empty() ? "" : "; did you mean '" + near + "'?"));
+    throw ConfigError(
+        fmt::format("unknown settings key '{}'{}", key, near.empty() ? "" : "; did you mean '" + near + "'?"));
   }
   switch (spec->type) {
     case KeyType::Int:
@@ -79,7 +80,8 @@ std::string Config::get(const std::string& key) const {
       return fmt::format("{}", fmt::join(setting<std::vector<std::string>>(s, key), ","));
     case KeyType::TextMap: {
       std::vector<std::string> pairs;
-      for (const auto& [from, to] : setting<std::map<std::string, std::string>>(s, key)) pairs.push_back(from + ":" + to);
+      for (const auto& [from, to] : setting<std::map<std::string, std::string>>(s, key))
+        pairs.push_back(from + ":" + to);
       return fmt::format("{}", fmt::join(pairs, ","));
     }
   }

@@ -44,9 +44,12 @@ std::vector<TimedPose> to_timed(const Trajectory& t) {
 
 TrackingState to_state(slam::TrackState s) {
   switch (s) {
-    case slam::TrackState::Ok: return TrackingState::Tracking;
-    case slam::TrackState::Lost: return TrackingState::Lost;
-    case slam::TrackState::NotInitialized: return TrackingState::NotInitialized;
+    case slam::TrackState::Ok:
+      return TrackingState::Tracking;
+    case slam::TrackState::Lost:
+      return TrackingState::Lost;
+    case slam::TrackState::NotInitialized:
+      return TrackingState::NotInitialized;
   }
   return TrackingState::Lost;
 }
@@ -107,9 +110,10 @@ struct Slam::Impl final : Observer {
   void check_timestamp(double t) const {
     if (!std::isfinite(t)) throw InputError(fmt::format("frame timestamp {} is not a finite number", t));
     if (last_timestamp && t <= *last_timestamp)
-      throw InputError(fmt::format("frame timestamp {:.6f} is not after the previous frame's ({:.6f}): timestamps "
-                                   "must increase",
-                                   t, *last_timestamp));
+      throw InputError(
+          fmt::format("frame timestamp {:.6f} is not after the previous frame's ({:.6f}): timestamps "
+                      "must increase",
+                      t, *last_timestamp));
   }
 
   // The pipeline lock for a call from another thread (see `waiting`).
@@ -177,9 +181,9 @@ struct Slam::Impl final : Observer {
 
   void on_keyframe_mapped(const slam::KeyframeMapped& m) override {
     if (!m.ba) return;
-    const LocalBaInfo info{m.keyframe_id,       m.timestamp,          m.ba->final_alpha, m.ba->fitted_alpha,
-                           m.ba->keyframes,    m.ba->points,         m.ba->observations, m.ba->outliers,
-                           m.ba->ms};
+    const LocalBaInfo info{m.keyframe_id,      m.timestamp,     m.ba->final_alpha,
+                           m.ba->fitted_alpha, m.ba->keyframes, m.ba->points,
+                           m.ba->observations, m.ba->outliers,  m.ba->ms};
     for (Listener* l : listeners) l->on_local_ba(info);
   }
   void on_loop(const slam::LoopRecord& l) override {

@@ -35,16 +35,15 @@ bool bag_support_built() { return false; }
 
 namespace {
 [[noreturn]] void no_support(const fs::path& bag) {
-  throw InputError(fmt::format("{}: this varslam was built without ROS bag support; install the ROS 1 packages "
-                               "(scripts/setup.sh does) and rebuild (scripts/build.sh)",
-                               bag.string()));
+  throw InputError(
+      fmt::format("{}: this varslam was built without ROS bag support; install the ROS 1 packages "
+                  "(scripts/setup.sh does) and rebuild (scripts/build.sh)",
+                  bag.string()));
 }
 }  // namespace
 
 Settings settings_for_bag(const fs::path& bag, const std::optional<fs::path>&, const BagTopics&) { no_support(bag); }
-std::unique_ptr<Dataset> open_bag_dataset(const fs::path& bag, const Settings&, const BagTopics&) {
-  no_support(bag);
-}
+std::unique_ptr<Dataset> open_bag_dataset(const fs::path& bag, const Settings&, const BagTopics&) { no_support(bag); }
 
 #else
 
@@ -81,9 +80,8 @@ std::vector<ListEntry> topic_entries(const bagfile::Reader& reader, const std::s
     out.push_back({stamps[i], std::to_string(i), fmt::format("{}:{} message {}", reader.file(), topic, i)});
   }
   std::stable_sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.timestamp < b.timestamp; });
-  const auto dup = std::unique(out.begin(), out.end(), [](const auto& a, const auto& b) {
-    return a.timestamp == b.timestamp;
-  });
+  const auto dup =
+      std::unique(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.timestamp == b.timestamp; });
   if (dup != out.end()) {
     spdlog::warn("{}:{}: {} messages repeat an earlier stamp; the first of each is used", reader.file(), topic,
                  std::distance(dup, out.end()));
@@ -140,9 +138,10 @@ class BagDataset final : public Dataset {
 
     const bagfile::Image depth = bag_.reader->image(bag_.topics.depth, std::stoul(f.depth.path));
     if (depth.mat.size() != colour.size())
-      throw InputError(fmt::format("{}: depth image is {}x{} but colour is {}x{}; register depth to colour (a "
-                                   "RealSense 'aligned_depth_to_color' stream) or choose another --topic-depth",
-                                   f.depth.where, depth.mat.cols, depth.mat.rows, colour.cols, colour.rows));
+      throw InputError(
+          fmt::format("{}: depth image is {}x{} but colour is {}x{}; register depth to colour (a "
+                      "RealSense 'aligned_depth_to_color' stream) or choose another --topic-depth",
+                      f.depth.where, depth.mat.cols, depth.mat.rows, colour.cols, colour.rows));
     out.depth = to_metres(depth, f.depth.where);
     return out;
   }
@@ -151,8 +150,8 @@ class BagDataset final : public Dataset {
   cv::Mat to_metres(const bagfile::Image& d, const std::string& where) const {
     if (d.mat.type() == CV_16UC1) return depth_to_metres(d.mat, depth_factor_);
     if (d.mat.type() != CV_32FC1)
-      throw InputError(fmt::format("{}: depth of encoding '{}' is not 16-bit or 32-bit float depth", where,
-                                   d.encoding));
+      throw InputError(
+          fmt::format("{}: depth of encoding '{}' is not 16-bit or 32-bit float depth", where, d.encoding));
     cv::Mat m = d.mat.clone();  // float metres; NaN and negative values are "no depth"
     m.forEach<float>([](float& v, const int*) {
       if (!(v > 0) || !std::isfinite(v)) v = 0.0f;
@@ -162,8 +161,8 @@ class BagDataset final : public Dataset {
 
   void check_size(const cv::Mat& img, const std::string& where, const char* what) const {
     if (img.cols == width_ && img.rows == height_) return;
-    throw InputError(fmt::format("{}: {} image is {}x{} but the camera is {}x{}", where, what, img.cols, img.rows,
-                                 width_, height_));
+    throw InputError(
+        fmt::format("{}: {} image is {}x{} but the camera is {}x{}", where, what, img.cols, img.rows, width_, height_));
   }
 
   fs::path path_;
@@ -224,14 +223,16 @@ Settings settings_for_bag(const fs::path& bag, const std::optional<fs::path>& fi
     return s;
   }
   if (b.topics.info.empty())
-    throw InputError(fmt::format("{}: no CameraInfo topic for the colour images {}; give the camera with --settings "
-                                 "FILE (config/ has TUM, Bonn and OpenLORIS cameras) or name one with --topic-info",
-                                 bag.string(), b.topics.rgb));
+    throw InputError(
+        fmt::format("{}: no CameraInfo topic for the colour images {}; give the camera with --settings "
+                    "FILE (config/ has TUM, Bonn and OpenLORIS cameras) or name one with --topic-info",
+                    bag.string(), b.topics.rgb));
   const auto info = b.reader->camera_info(b.topics.info);
   if (!info || !(info->fx > 0) || !(info->fy > 0) || info->width <= 0 || info->height <= 0)
-    throw InputError(fmt::format("{}:{}: the CameraInfo holds no camera (fx, fy, width or height is 0); give the "
-                                 "camera with --settings FILE",
-                                 bag.string(), b.topics.info));
+    throw InputError(
+        fmt::format("{}:{}: the CameraInfo holds no camera (fx, fy, width or height is 0); give the "
+                    "camera with --settings FILE",
+                    bag.string(), b.topics.info));
   YAML::Node root;
   root["camera"]["fx"] = info->fx;
   root["camera"]["fy"] = info->fy;
@@ -243,9 +244,10 @@ Settings settings_for_bag(const fs::path& bag, const std::optional<fs::path>& fi
                          info->distortion_model == "rational_polynomial";
   const bool distorted = std::any_of(info->d.begin(), info->d.end(), [](double v) { return v != 0; });
   if (distorted && !plumb_bob)
-    throw InputError(fmt::format("{}:{}: distortion model '{}' is not supported (plumb_bob is); give the camera "
-                                 "with --settings FILE",
-                                 bag.string(), b.topics.info, info->distortion_model));
+    throw InputError(
+        fmt::format("{}:{}: distortion model '{}' is not supported (plumb_bob is); give the camera "
+                    "with --settings FILE",
+                    bag.string(), b.topics.info, info->distortion_model));
   const char* keys[] = {"k1", "k2", "p1", "p2", "k3"};
   for (std::size_t k = 0; k < 5 && k < info->d.size(); ++k) root["camera"][keys[k]] = info->d[k];
   const double factor = units > 0 ? 1.0 / units : kRep118DepthFactor;
@@ -254,8 +256,8 @@ Settings settings_for_bag(const fs::path& bag, const std::optional<fs::path>& fi
   if (const double dt = median_frame_interval(rgb); dt > 0) root["camera"]["fps"] = std::min(1000.0, 1.0 / dt);
   Settings s = settings_from_yaml(root, fs::path(bag.string() + ":" + b.topics.info));
   s.dataset_dir = bag.parent_path();
-  spdlog::info("{}: camera from CameraInfo {} (fx {} fy {} cx {} cy {}, {}x{}); depth {}", bag.string(),
-               b.topics.info, info->fx, info->fy, info->cx, info->cy, info->width, info->height,
+  spdlog::info("{}: camera from CameraInfo {} (fx {} fy {} cx {} cy {}, {}x{}); depth {}", bag.string(), b.topics.info,
+               info->fx, info->fy, info->cx, info->cy, info->width, info->height,
                float_depth ? std::string("in metres (32FC1)")
                : units > 0 ? fmt::format("unit {} m from {}", units, b.topics.depth_units)
                            : std::string("in millimetres (ROS REP 118; the bag states no unit)"));
@@ -268,17 +270,17 @@ std::unique_ptr<Dataset> open_bag_dataset(const fs::path& bag, const Settings& s
   const std::vector<ListEntry> depth = topic_entries(*b.reader, b.topics.depth);
   std::vector<FramePair> frames = associate_frames(rgb, depth, kMaxAssociationDt);
   if (frames.empty())
-    throw InputError(fmt::format("{}: no colour message of {} has a depth message of {} within {} s ({} and {} "
-                                 "messages)",
-                                 bag.string(), b.topics.rgb, b.topics.depth, kMaxAssociationDt, rgb.size(),
-                                 depth.size()));
+    throw InputError(
+        fmt::format("{}: no colour message of {} has a depth message of {} within {} s ({} and {} "
+                    "messages)",
+                    bag.string(), b.topics.rgb, b.topics.depth, kMaxAssociationDt, rgb.size(), depth.size()));
   if (frames.size() < rgb.size())
     spdlog::info("{}: {} of {} colour frames have no depth within {} s and are dropped", bag.string(),
                  rgb.size() - frames.size(), rgb.size(), kMaxAssociationDt);
   std::optional<fs::path> gt;
   if (!wanted.gt_frame.empty()) gt = extract_groundtruth(*b.reader, wanted.gt_frame);
-  spdlog::info("{}: bag, colour {}, depth {}, {} frames{}", bag.string(), b.topics.rgb, b.topics.depth,
-               frames.size(), gt ? ", with ground truth" : "");
+  spdlog::info("{}: bag, colour {}, depth {}, {} frames{}", bag.string(), b.topics.rgb, b.topics.depth, frames.size(),
+               gt ? ", with ground truth" : "");
   return std::make_unique<BagDataset>(bag, std::move(b), std::move(frames), settings, std::move(gt));
 }
 

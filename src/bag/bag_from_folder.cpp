@@ -21,9 +21,10 @@ namespace fs = std::filesystem;
 #ifndef VARSLAM_HAVE_ROSBAG
 
 BagWriteSummary write_bag_from_dataset(const Dataset&, const Settings&, const fs::path& out, const BagWriteOptions&) {
-  throw InputError(fmt::format("{}: this varslam was built without ROS bag support; install the ROS 1 packages "
-                               "(scripts/setup.sh does) and rebuild (scripts/build.sh)",
-                               out.string()));
+  throw InputError(
+      fmt::format("{}: this varslam was built without ROS bag support; install the ROS 1 packages "
+                  "(scripts/setup.sh does) and rebuild (scripts/build.sh)",
+                  out.string()));
 }
 
 #else
@@ -34,9 +35,10 @@ struct LayoutTopics {
   const char *rgb, *depth, *rgb_info, *depth_info, *depth_units, *rgb_frame, *depth_frame, *people;
 };
 
-constexpr LayoutTopics kTumTopics{"/camera/rgb/image_color", "/camera/depth/image", "/camera/rgb/camera_info",
-                                  "/camera/depth/camera_info", "/camera/depth/depth_units",
-                                  "/openni_rgb_optical_frame", "/openni_depth_optical_frame", "/camera/rgb/people"};
+constexpr LayoutTopics kTumTopics{"/camera/rgb/image_color",     "/camera/depth/image",
+                                  "/camera/rgb/camera_info",     "/camera/depth/camera_info",
+                                  "/camera/depth/depth_units",   "/openni_rgb_optical_frame",
+                                  "/openni_depth_optical_frame", "/camera/rgb/people"};
 constexpr LayoutTopics kRealSenseTopics{"/device_0/sensor_1/Color_0/image/data",
                                         "/device_0/sensor_0/Depth_0/image/data",
                                         "/device_0/sensor_1/Color_0/info/camera_info",
@@ -85,12 +87,12 @@ BagWriteSummary write_bag_from_dataset(const Dataset& dataset, const Settings& s
   if (first == end) throw InputError(fmt::format("{}: no frames to write", dataset.root().string()));
   // ROS time 0 means "no stamp", and bags refuse it: datasets whose clock starts at 0 need an offset.
   if (const double t0 = dataset.timestamp(first) + options.time_offset; !(t0 >= 1e-6))
-    throw InputError(fmt::format("{}: the first frame's timestamp is {:.6f} s{}; a ROS bag cannot hold times at or "
-                                 "before 0 (time 0 means 'unset'): give --time-offset 1 (added to every stamp, "
-                                 "ground truth included)",
-                                 dataset.root().string(), dataset.timestamp(first),
-                                 options.time_offset != 0 ? fmt::format(" (with offset {})", options.time_offset)
-                                                          : std::string()));
+    throw InputError(
+        fmt::format("{}: the first frame's timestamp is {:.6f} s{}; a ROS bag cannot hold times at or "
+                    "before 0 (time 0 means 'unset'): give --time-offset 1 (added to every stamp, "
+                    "ground truth included)",
+                    dataset.root().string(), dataset.timestamp(first),
+                    options.time_offset != 0 ? fmt::format(" (with offset {})", options.time_offset) : std::string()));
   if (out.has_parent_path()) fs::create_directories(out.parent_path());
   const fs::path tmp = out.string() + ".partial";
   BagWriteSummary summary;
@@ -116,7 +118,7 @@ BagWriteSummary write_bag_from_dataset(const Dataset& dataset, const Settings& s
       const RgbdFrame f = dataset.load(i);
       const double stamp = f.timestamp + dt;
       if (const Detections people = boxes_near(boxes, f.timestamp, 1e-4); !people.empty()) {  // before the images
-        std::vector<std::array<float, 3>> corners;
+        std::vector<std::array<float, 3> > corners;
         for (const Detection& d : people) {
           corners.push_back({d.box.x, d.box.y, d.score});
           corners.push_back({d.box.x + d.box.width, d.box.y + d.box.height, d.score});

@@ -29,8 +29,9 @@ struct BagWriteSummary {
 /// Writes the frames of `dataset` (read with `settings`: the camera goes into CameraInfo messages, the depth factor
 /// into a depth-unit topic) to `out`, with its ground truth as /tf (parent "world", child "kinect") when it has
 /// one, and its person boxes (boxes.txt) as geometry_msgs/PolygonStamped on <colour namespace>/people (two corners
-/// per box, z = score: what varslam_node takes as person boxes). TUM layout, raw: colour bgr8 and depth 32FC1 metres exactly as the folder reader decodes them, so a
-/// deterministic run on the bag gives the folder's trajectory. Written to a temporary name, then renamed.
+/// per box, z = score: what varslam_node takes as person boxes). TUM layout, raw: colour bgr8 and depth 32FC1 metres
+/// exactly as the folder reader decodes them, so a deterministic run on the bag gives the folder's trajectory. Written
+/// to a temporary name, then renamed.
 BagWriteSummary write_bag_from_dataset(const Dataset& dataset, const Settings& settings,
                                        const std::filesystem::path& out, const BagWriteOptions& options);
 

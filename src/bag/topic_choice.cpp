@@ -68,8 +68,8 @@ const TopicEntry& named(const std::string& bag, const std::vector<TopicEntry>& t
                         const char* option) {
   for (const auto& t : topics)
     if (t.name == name) return t;
-  throw InputError(fmt::format("{}: {} {} is not in the bag; its topics are:{}", bag, option, name,
-                               list_topics(topics)));
+  throw InputError(
+      fmt::format("{}: {} {} is not in the bag; its topics are:{}", bag, option, name, list_topics(topics)));
 }
 
 std::size_t shared_components(const std::string& a, const std::string& b) {
@@ -95,33 +95,34 @@ ChosenTopics choose_topics(const std::string& bag, const std::vector<TopicEntry>
     throw InputError(fmt::format("{}: no image topic (sensor_msgs/Image or CompressedImage); its topics are:{}", bag,
                                  list_topics(topics)));
   ChosenTopics out;
-  for (auto [given, chosen, option] : {std::tuple{&rgb, &out.rgb, "--topic-rgb"},
-                                       std::tuple{&depth, &out.depth, "--topic-depth"}}) {
+  for (auto [given, chosen, option] :
+       {std::tuple{&rgb, &out.rgb, "--topic-rgb"}, std::tuple{&depth, &out.depth, "--topic-depth"}}) {
     if (given->empty()) continue;
     const TopicEntry& t = named(bag, topics, *given, option);
     if (!is_image(t))
-      throw InputError(fmt::format("{}: {} {} is a {}, not an image topic (sensor_msgs/Image or CompressedImage)",
-                                   bag, option, *given, t.type));
+      throw InputError(fmt::format("{}: {} {} is a {}, not an image topic (sensor_msgs/Image or CompressedImage)", bag,
+                                   option, *given, t.type));
     *chosen = *given;
   }
   if (out.rgb.empty()) {
     auto c = best(bag, colour, colour_rank, "colour images", "--topic-rgb");
     if (!c)
-      throw InputError(fmt::format("{}: no colour image topic (only depth); choose one with --topic-rgb; its topics "
-                                   "are:{}",
-                                   bag, list_topics(topics)));
+      throw InputError(
+          fmt::format("{}: no colour image topic (only depth); choose one with --topic-rgb; its topics "
+                      "are:{}",
+                      bag, list_topics(topics)));
     out.rgb = *c;
   }
   if (out.depth.empty()) {
     auto d = best(bag, depths, depth_rank, "depth images", "--topic-depth");
     if (!d)
-      throw InputError(fmt::format("{}: no depth image topic (a topic with 'depth' in its name); choose one with "
-                                   "--topic-depth; its topics are:{}",
-                                   bag, list_topics(topics)));
+      throw InputError(
+          fmt::format("{}: no depth image topic (a topic with 'depth' in its name); choose one with "
+                      "--topic-depth; its topics are:{}",
+                      bag, list_topics(topics)));
     out.depth = *d;
   }
-  if (out.rgb == out.depth)
-    throw InputError(fmt::format("{}: colour and depth are the same topic {}", bag, out.rgb));
+  if (out.rgb == out.depth) throw InputError(fmt::format("{}: colour and depth are the same topic {}", bag, out.rgb));
   if (!info.empty()) {
     const TopicEntry& t = named(bag, topics, info, "--topic-info");
     if (t.type != kCameraInfo)

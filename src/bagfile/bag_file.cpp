@@ -1,8 +1,8 @@
 #include "bagfile/bag_file.hpp"
 
+#include <geometry_msgs/PolygonStamped.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
-#include <geometry_msgs/PolygonStamped.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/Image.h>
@@ -19,8 +19,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "io/ros_image_codec.hpp"
 #include "core/error.hpp"
+#include "io/ros_image_codec.hpp"
 
 namespace varslam::bagfile {
 namespace {
@@ -145,7 +145,7 @@ Image Reader::image(const std::string& topic, std::size_t i) const {
     const auto p = impl_->read<sensor_msgs::Image>(msgs[i], where);
     if (!p) throw InputError(where + ": not a " + std::string(kImageType));
     return {ros_image::decode_raw_image(p->encoding, p->width, p->height, p->step, p->is_bigendian != 0, p->data.data(),
-                             p->data.size(), where),
+                                        p->data.size(), where),
             p->encoding};
   }
   if (type == kCompressedType) {
@@ -190,15 +190,15 @@ std::vector<Transform> Reader::transforms(const std::string& child) const {
     const auto it = impl_->messages.find(topic);
     if (it == impl_->messages.end()) continue;
     for (std::size_t i = 0; i < it->second.size(); ++i) {
-      const auto p = impl_->read<tf2_msgs::TFMessage>(it->second[i], impl_->file + ":" + topic + "#" +
-                                                                         std::to_string(i));
+      const auto p =
+          impl_->read<tf2_msgs::TFMessage>(it->second[i], impl_->file + ":" + topic + "#" + std::to_string(i));
       if (!p) continue;
       for (const auto& t : p->transforms) {
         if (strip_slash(t.child_frame_id) != want) continue;
         const auto& tr = t.transform.translation;
         const auto& q = t.transform.rotation;
-        out.push_back({t.header.stamp.toSec(), t.header.frame_id, t.child_frame_id, tr.x, tr.y, tr.z, q.x, q.y, q.z,
-                       q.w});
+        out.push_back(
+            {t.header.stamp.toSec(), t.header.frame_id, t.child_frame_id, tr.x, tr.y, tr.z, q.x, q.y, q.z, q.w});
       }
     }
   }

@@ -5,11 +5,10 @@
 #include <array>
 #include <cstddef>
 #include <memory>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 namespace varslam::bagfile {
 

@@ -45,10 +45,11 @@ cv::Mat decode_raw_image(const std::string& encoding, std::uint32_t width, std::
                      " with step " + std::to_string(step) + " needs " +
                      std::to_string(static_cast<std::size_t>(step) * height) + " bytes, the message holds " +
                      std::to_string(size));
-  const int type = bpp == 3 ? CV_8UC3 : bpp == 4 && encoding != "32FC1" ? CV_8UC4
-                   : bpp == 1                                          ? CV_8UC1
-                   : bpp == 2                                          ? CV_16UC1
-                                                                       : CV_32FC1;
+  const int type = bpp == 3                          ? CV_8UC3
+                   : bpp == 4 && encoding != "32FC1" ? CV_8UC4
+                   : bpp == 1                        ? CV_8UC1
+                   : bpp == 2                        ? CV_16UC1
+                                                     : CV_32FC1;
   const cv::Mat view(static_cast<int>(height), static_cast<int>(width), type, const_cast<std::uint8_t*>(data), step);
   cv::Mat out;
   if (encoding == "rgb8") {
@@ -96,8 +97,7 @@ cv::Mat decode_compressed_image(const std::string& format, const std::uint8_t* d
   if (format.rfind("16UC1", 0) == 0 || format.rfind("mono16", 0) == 0) return raw;
   if (format.rfind("32FC1", 0) != 0)
     throw InputError(where + ": compressedDepth format '" + format + "' names no depth type (16UC1 or 32FC1)");
-  if (!(quant_a > 0))
-    throw InputError(where + ": 32FC1 compressedDepth without its quantisation parameters");
+  if (!(quant_a > 0)) throw InputError(where + ": 32FC1 compressedDepth without its quantisation parameters");
   // Inverse-depth quantisation: v = quant_a / z + quant_b.
   cv::Mat metres(raw.size(), CV_32FC1);
   for (int y = 0; y < raw.rows; ++y) {

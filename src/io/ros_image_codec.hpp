@@ -3,10 +3,9 @@
 // reader hands the message fields over, so this is tested and fuzzed on plain bytes.
 #include <cstddef>
 #include <cstdint>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 namespace varslam::ros_image {
 

@@ -85,7 +85,9 @@ TEST(ApiSlam, BadTimestampsAndImagesAreInputErrorsAndTheSessionGoesOn) {
   EXPECT_THAT(input_error([&] { slam.track(fr[1].bgr, fr[1].depth, fr[0].timestamp - 1); }), HasSubstr("not after"));
   EXPECT_THAT(input_error([&] { slam.track(cv::Mat(10, 10, CV_8UC3), fr[1].depth, fr[1].timestamp); }),
               AllOf(HasSubstr("10"), HasSubstr("640")));
-  EXPECT_THAT(input_error([&] { slam.track(fr[1].bgr, fr[1].depth, fr[1].timestamp, {{1, 2, -5, 3, 1}}); }),
+  EXPECT_THAT(input_error([&] {
+                slam.track(fr[1].bgr, fr[1].depth, fr[1].timestamp, {{1, 2, -5, 3, 1}});
+              }),
               HasSubstr("person box"));
   const varslam::TrackedFrame f = slam.track(fr[1].bgr, fr[1].depth, fr[1].timestamp);
   EXPECT_EQ(f.state, varslam::TrackingState::Tracking);
@@ -142,7 +144,8 @@ TEST(ApiSlam, AMapSavedWhileRunningIsFoundAgainAndResetStartsOver) {
   again.load_map(map.string());
   again.set_localization_only(true);
   std::size_t localized = 0;
-  for (std::size_t i = 5; i < fr.size(); ++i) localized += again.track(fr[i].bgr, fr[i].depth, fr[i].timestamp).pose ? 1 : 0;
+  for (std::size_t i = 5; i < fr.size(); ++i)
+    localized += again.track(fr[i].bgr, fr[i].depth, fr[i].timestamp).pose ? 1 : 0;
   EXPECT_GT(localized, (fr.size() - 5) * 9 / 10);
   EXPECT_EQ(again.summary().keyframes, again.map_snapshot()->keyframes.size());
   fs::remove(map);
@@ -153,8 +156,8 @@ TEST(ApiSlam, ASessionWritesNothingToStandardOutput) {
   ::testing::internal::CaptureStdout();
   {
     varslam::Slam slam(sequence().config);
-    for (std::size_t i = 0; i < 10; ++i) slam.track(sequence().frames[i].bgr, sequence().frames[i].depth,
-                                                    sequence().frames[i].timestamp);
+    for (std::size_t i = 0; i < 10; ++i)
+      slam.track(sequence().frames[i].bgr, sequence().frames[i].depth, sequence().frames[i].timestamp);
     slam.finish();
   }
   EXPECT_EQ(::testing::internal::GetCapturedStdout(), "");

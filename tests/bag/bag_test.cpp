@@ -11,8 +11,8 @@
 #include "bag/bag_dataset.hpp"
 #include "bag/bag_from_folder.hpp"
 #include "bag/topic_choice.hpp"
-#include "io/ros_image_codec.hpp"
 #include "core/error.hpp"
+#include "io/ros_image_codec.hpp"
 #include "io/trajectory_io.hpp"
 #include "slam/e2e_support.hpp"
 #ifdef VARSLAM_HAVE_ROSBAG
@@ -65,8 +65,9 @@ TEST(ImageCodec, RawEncodingsDecodeToBgrAndDepth) {
 
 TEST(ImageCodec, BrokenRawImagesAreNamedErrors) {
   const std::vector<std::uint8_t> few(10, 0);
-  EXPECT_THAT(error_of([&] { ros_image::decode_raw_image("yuv422", 2, 2, 4, false, few.data(), few.size(), "b:/t 3"); }),
-              AllOf(HasSubstr("b:/t 3"), HasSubstr("'yuv422' is not supported"), HasSubstr("rgb8")));
+  EXPECT_THAT(
+      error_of([&] { ros_image::decode_raw_image("yuv422", 2, 2, 4, false, few.data(), few.size(), "b:/t 3"); }),
+      AllOf(HasSubstr("b:/t 3"), HasSubstr("'yuv422' is not supported"), HasSubstr("rgb8")));
   EXPECT_THAT(error_of([&] { ros_image::decode_raw_image("bgr8", 4, 4, 12, false, few.data(), few.size(), "b:/t"); }),
               AllOf(HasSubstr("needs 48 bytes"), HasSubstr("holds 10")));
   EXPECT_THAT(error_of([&] { ros_image::decode_raw_image("bgr8", 4, 1, 4, false, few.data(), few.size(), "b:/t"); }),
@@ -77,7 +78,8 @@ TEST(ImageCodec, CompressedDepthRoundTripsAndBadDataIsNamed) {
   cv::Mat d(3, 4, CV_16UC1);
   for (int i = 0; i < 12; ++i) d.at<std::uint16_t>(i / 4, i % 4) = static_cast<std::uint16_t>(i * 1000);
   const auto bytes = ros_image::encode_compressed_depth(d);
-  const cv::Mat back = ros_image::decode_compressed_image("16UC1; compressedDepth png", bytes.data(), bytes.size(), "t");
+  const cv::Mat back =
+      ros_image::decode_compressed_image("16UC1; compressedDepth png", bytes.data(), bytes.size(), "t");
   ASSERT_EQ(back.type(), CV_16UC1);
   EXPECT_EQ(cv::norm(back, d, cv::NORM_INF), 0.0);
   // 32FC1 compressedDepth: inverse depth v = a / z + b.
@@ -89,8 +91,9 @@ TEST(ImageCodec, CompressedDepthRoundTripsAndBadDataIsNamed) {
   EXPECT_FLOAT_EQ(z.at<float>(0, 1), 1.0f);  // 1000 / 1000
   EXPECT_FLOAT_EQ(z.at<float>(0, 0), 0.0f);  // 0 = no depth
   const std::vector<std::uint8_t> junk(40, 7);
-  EXPECT_THAT(error_of([&] { ros_image::decode_compressed_image("16UC1; compressedDepth", junk.data(), 40, "b:/d 1"); }),
-              AllOf(HasSubstr("b:/d 1"), HasSubstr("holds no PNG")));
+  EXPECT_THAT(
+      error_of([&] { ros_image::decode_compressed_image("16UC1; compressedDepth", junk.data(), 40, "b:/d 1"); }),
+      AllOf(HasSubstr("b:/d 1"), HasSubstr("holds no PNG")));
   EXPECT_THAT(error_of([&] { ros_image::decode_compressed_image("jpeg", junk.data(), 40, "b:/c 1"); }),
               HasSubstr("not PNG or JPEG"));
 }
@@ -102,9 +105,10 @@ const char* kCmp = "sensor_msgs/CompressedImage";
 const char* kInfo = "sensor_msgs/CameraInfo";
 
 TEST(TopicChoice, FindsTheTumRealSenseAndOpenLorisLayouts) {
-  const std::vector<TopicEntry> tum = {{"/camera/depth/camera_info", kInfo, 1}, {"/camera/depth/image", kImg, 9},
-                                       {"/camera/rgb/camera_info", kInfo, 1}, {"/camera/rgb/image_color", kImg, 9},
-                                       {"/camera/rgb/image_color/compressed", kCmp, 9}, {"/tf", "tf2_msgs/TFMessage", 9}};
+  const std::vector<TopicEntry> tum = {
+      {"/camera/depth/camera_info", kInfo, 1},         {"/camera/depth/image", kImg, 9},
+      {"/camera/rgb/camera_info", kInfo, 1},           {"/camera/rgb/image_color", kImg, 9},
+      {"/camera/rgb/image_color/compressed", kCmp, 9}, {"/tf", "tf2_msgs/TFMessage", 9}};
   const ChosenTopics t = choose_topics("b", tum, "", "", "");
   EXPECT_EQ(t.rgb, "/camera/rgb/image_color");
   EXPECT_EQ(t.depth, "/camera/depth/image");
@@ -120,7 +124,8 @@ TEST(TopicChoice, FindsTheTumRealSenseAndOpenLorisLayouts) {
   EXPECT_EQ(r.depth, "/device_0/sensor_0/Depth_0/image/data");
   EXPECT_EQ(r.info, "/device_0/sensor_1/Color_0/info/camera_info");
   EXPECT_EQ(r.depth_units, "/device_0/sensor_0/option/Depth Units/value");
-  const std::vector<TopicEntry> lo = {{"/d400/color/image_raw", kImg, 9}, {"/d400/color/camera_info", kInfo, 1},
+  const std::vector<TopicEntry> lo = {{"/d400/color/image_raw", kImg, 9},
+                                      {"/d400/color/camera_info", kInfo, 1},
                                       {"/d400/depth/image_raw", kImg, 9},
                                       {"/d400/aligned_depth_to_color/image_raw", kImg, 9},
                                       {"/d400/depth/camera_info", kInfo, 1}};
@@ -131,11 +136,11 @@ TEST(TopicChoice, FindsTheTumRealSenseAndOpenLorisLayouts) {
 }
 
 TEST(TopicChoice, AmbiguityMissingTopicsAndWrongTypesAreNamed) {
-  const std::vector<TopicEntry> two = {{"/left/color/image_raw", kImg, 9}, {"/right/color/image_raw", kImg, 9},
-                                       {"/left/depth/image_raw", kImg, 9}};
-  EXPECT_THAT(error_of([&] { choose_topics("x.bag", two, "", "", ""); }),
-              AllOf(HasSubstr("x.bag"), HasSubstr("/left/color/image_raw, /right/color/image_raw"),
-                    HasSubstr("--topic-rgb")));
+  const std::vector<TopicEntry> two = {
+      {"/left/color/image_raw", kImg, 9}, {"/right/color/image_raw", kImg, 9}, {"/left/depth/image_raw", kImg, 9}};
+  EXPECT_THAT(
+      error_of([&] { choose_topics("x.bag", two, "", "", ""); }),
+      AllOf(HasSubstr("x.bag"), HasSubstr("/left/color/image_raw, /right/color/image_raw"), HasSubstr("--topic-rgb")));
   EXPECT_EQ(choose_topics("x.bag", two, "/right/color/image_raw", "", "").rgb, "/right/color/image_raw");
   const std::vector<TopicEntry> none = {{"/imu", "sensor_msgs/Imu", 5}, {"/tf", "tf2_msgs/TFMessage", 5}};
   EXPECT_THAT(error_of([&] { choose_topics("x.bag", none, "", "", ""); }),
@@ -246,7 +251,8 @@ TEST(BagInput, TheSettingsFileWinsOverCameraInfo) {
   other.root["camera"]["fx"] = 600;
   save_settings(other, yaml);
   EXPECT_EQ(settings_for_bag(bag, yaml, {}).camera.fx, 600);
-  EXPECT_EQ(settings_for_bag(bag, std::nullopt, {}).camera.fx, settings_for_dataset(sequence(), std::nullopt).camera.fx);
+  EXPECT_EQ(settings_for_bag(bag, std::nullopt, {}).camera.fx,
+            settings_for_dataset(sequence(), std::nullopt).camera.fx);
 }
 
 // --- bad bags --------------------------------------------------------------------------------------------------------
@@ -258,8 +264,7 @@ TEST(BadBag, NotABagTruncatedAndUnindexedAreNamed) {
   std::ofstream(dir / "text.bag") << "timestamp x y z\n";
   EXPECT_THAT(error_of([&] { settings_for_bag(dir / "text.bag", std::nullopt, {}); }),
               AllOf(HasSubstr("text.bag"), HasSubstr("not a ROS bag")));
-  EXPECT_THAT(error_of([&] { settings_for_bag(dir / "missing.bag", std::nullopt, {}); }),
-              HasSubstr("does not exist"));
+  EXPECT_THAT(error_of([&] { settings_for_bag(dir / "missing.bag", std::nullopt, {}); }), HasSubstr("does not exist"));
   // A recording cut off before its index was written.
   const fs::path good = write_bag("for_cut", BagLayout::Tum, BagImages::Png);
   const std::string bytes = slurp(good);
@@ -295,8 +300,8 @@ TEST(BadBag, NoImagesUnknownEncodingAndMismatchedDepthAreNamed) {
   const Settings s = settings_for_bag(dir / "odd.bag", std::nullopt, {});
   EXPECT_EQ(s.camera.width, 8);
   const auto ds = open_bag_dataset(dir / "odd.bag", s, {});
-  EXPECT_THAT(error_of([&] { ds->load(0); }),
-              AllOf(HasSubstr("odd.bag:/camera/depth/image message 0"), HasSubstr("depth image is 4x3 but colour is 8x6")));
+  EXPECT_THAT(error_of([&] { ds->load(0); }), AllOf(HasSubstr("odd.bag:/camera/depth/image message 0"),
+                                                    HasSubstr("depth image is 4x3 but colour is 8x6")));
   BagTopics body;
   body.gt_frame = "body";
   EXPECT_THAT(error_of([&] { open_bag_dataset(dir / "odd.bag", s, body); }),
