@@ -58,6 +58,10 @@ TEST(ImageCodec, RawEncodingsDecodeToBgrAndDepth) {
   const std::vector<std::uint8_t> d16be = {0x27, 0x10};
   EXPECT_EQ(ros_image::decode_raw_image("mono16", 1, 1, 2, true, d16be.data(), 2, "t").at<std::uint16_t>(0, 0), 10000);
   // Rows padded beyond width * bytes per pixel (step) are read row by row.
+  // A step that is not a multiple of the pixel size (found by fuzzing: OpenCV refuses it as a matrix step).
+  const std::vector<std::uint8_t> odd = {0x10, 0x27, 99, 0x20, 0x4e, 99};
+  const cv::Mat odd_depth = ros_image::decode_raw_image("16UC1", 1, 2, 3, false, odd.data(), odd.size(), "t");
+  EXPECT_EQ(odd_depth.at<std::uint16_t>(1, 0), 20000);
   const std::vector<std::uint8_t> padded = {7, 99, 8, 99};
   const cv::Mat mono = ros_image::decode_raw_image("mono8", 1, 2, 2, false, padded.data(), padded.size(), "t");
   EXPECT_EQ(mono.at<std::uint8_t>(1, 0), 8);
