@@ -179,7 +179,8 @@ void Pipeline::calibrate_depth(std::span<const RgbdFrame> samples) {
 }
 
 void Pipeline::start(std::span<const RgbdFrame> samples) {
-  const DepthRegistrationEvent reg = register_depth_if_needed(samples, settings_, cfg_);
+  DepthRegistrationEvent reg = register_depth_if_needed(samples, settings_, cfg_);
+  if (pending_map_ && reg.found) adopt_map_camera(reg);
   system_ = std::make_unique<slam::System>(cfg_, settings_.camera, settings_.close_depth_m(), options_.mode,
                                            relay_.get());
   if (pending_map_) {
@@ -191,6 +192,21 @@ void Pipeline::start(std::span<const RgbdFrame> samples) {
   system_->set_localization_only(localization_only_);
   if (masker_) install_person_filter();
   emit(reg, &Observer::on_depth_registration);
+}
+
+// A loaded map brings the colour camera it was built with: this session's estimate from its own few frames is
+// compared and logged, and the map's is used (two estimates of one camera differ by about 1 %, enough to refuse).
+void Pipeline::adopt_map_camera(DepthRegistrationEvent& reg) {
+  const PinholeCamera& map = pending_map_->fingerprint.camera;
+  PinholeCamera& now = settings_.camera;
+  spdlog::info("{}: the map's colour camera (fx {:.1f} fy {:.1f} cx {:.1f} cy {:.1f}) is used; this session estimated "
+               "fx {:.1f} fy {:.1f} cx {:.1f} cy {:.1f} from its own frames",
+               pending_map_file_.string(), map.fx, map.fy, map.cx, map.cy, now.fx, now.fy, now.cx, now.cy);
+  now.fx = map.fx;
+  now.fy = map.fy;
+  now.cx = map.cx;
+  now.cy = map.cy;
+  reg.colour_camera = now;
 }
 
 void Pipeline::install_person_filter() {

@@ -119,6 +119,7 @@ class Pipeline {
   class Relay;  // takes the stages' records (any thread) and queues them for the observers
   void start(std::span<const RgbdFrame> samples);
   void install_person_filter();
+  void adopt_map_camera(DepthRegistrationEvent& reg);
   void deliver_queued();
   template <typename Event, typename Fn>
   void emit(const Event& e, Fn fn);
