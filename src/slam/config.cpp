@@ -129,6 +129,7 @@ SlamConfig slam_config_from(const Settings& s) {
   r.min_score = setting<int>(s, "relocalization.min_score");
   r.candidates = static_cast<std::size_t>(setting<int>(s, "relocalization.candidates"));
   r.min_inliers = setting<int>(s, "relocalization.min_inliers");
+  r.loaded_map_min_inliers = setting<int>(s, "relocalization.loaded_map_min_inliers");
   r.loaded_map_patience = setting<int>(s, "relocalization.loaded_map_patience");
   return c;
 }

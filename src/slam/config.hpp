@@ -116,6 +116,7 @@ struct RelocalizationConfig {
   int min_score = setting_keys::int_default("relocalization.min_score");          // signature matches (of 256) for a candidate keyframe
   std::size_t candidates = setting_keys::int_default("relocalization.candidates");  // candidates tried per lost frame
   int min_inliers = setting_keys::int_default("relocalization.min_inliers");        // pose inliers against the candidate keyframe
+  int loaded_map_min_inliers = setting_keys::int_default("relocalization.loaded_map_min_inliers");  // first fix in a loaded map
   int loaded_map_patience = setting_keys::int_default("relocalization.loaded_map_patience");
 };
 

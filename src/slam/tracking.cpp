@@ -514,7 +514,9 @@ bool Tracker::relocalize(Frame& cur, FrameTimings& t) {
   const auto candidates = places_->query(places_->signature(*cur.features), cfg_.relocalization.min_score,
                                          cfg_.relocalization.candidates);
   LocalizationConfig lc;
-  lc.min_inliers = cfg_.relocalization.min_inliers;
+  // The first fix in a loaded map: no earlier pose narrows the candidates, and the local-map check that follows
+  // (track_local_map, 50 inliers after a recovery) verifies the pose against the whole neighbourhood.
+  lc.min_inliers = awaiting_loaded_map_ ? cfg_.relocalization.loaded_map_min_inliers : cfg_.relocalization.min_inliers;
   lc.kernel = cfg_.tracking.kernel;
   for (const auto& cand : candidates) {
     const int inliers = locate_against_keyframe(cur, *cand.keyframe, lc);
