@@ -224,8 +224,8 @@ void VarslamNode::tracking_loop() {
   }
 }
 
-bool VarslamNode::ensure_session(const sensor_msgs::Image& rgb) {
-  if (slam_) return true;
+void VarslamNode::ensure_session(const sensor_msgs::Image& rgb) {
+  if (slam_) return;
   {
     std::lock_guard<std::mutex> lock(queue_mutex_);
     slam_ = std::make_unique<varslam::Slam>(config_,
@@ -247,7 +247,6 @@ bool VarslamNode::ensure_session(const sensor_msgs::Image& rgb) {
   if (params_.camera_frame.front() == '/') params_.camera_frame.erase(0, 1);  // tf2 frame ids have no leading '/'
   if (params_.load_map_at_start) slam_->load_map(params_.map_file);
   if (params_.localization_only) slam_->set_localization_only(true);
-  return true;
 }
 
 void VarslamNode::track(const Pending& p) {

@@ -57,7 +57,7 @@ class VarslamNode : public varslam::Listener {
   void on_colour_seen(const sensor_msgs::ImageConstPtr&) { ++colour_seen_; }
   void tracking_loop();
   void track(const Pending& p);
-  bool ensure_session(const sensor_msgs::Image& rgb);
+  void ensure_session(const sensor_msgs::Image& rgb);
   void publish_pose(const varslam::TrackedFrame& f, const std_msgs::Header& header);
   /// The transform the node puts on /tf for a pose: map -> camera, or map -> odom with ~odom_frame (empty when
   /// odom -> camera is not on /tf at that time).
