@@ -168,8 +168,7 @@ std::optional<std::vector<varslam::PersonBox>> VarslamNode::people_for(const ros
 void VarslamNode::on_person_boxes(const varslam::PersonBoxesInfo& info) {
   if (people_pub_.getNumSubscribers() == 0) return;
   // Each box drawn as a rectangle 1 m in front of the camera (the image plane at unit depth), in the camera frame.
-  const double fx = std::stod(config_.get("camera.fx")), fy = std::stod(config_.get("camera.fy"));
-  const double cx = std::stod(config_.get("camera.cx")), cy = std::stod(config_.get("camera.cy"));
+  const auto [fx, fy, cx, cy] = intrinsics_;
   visualization_msgs::MarkerArray markers;
   visualization_msgs::Marker m;
   m.header.stamp = ros::Time(info.timestamp);
@@ -232,6 +231,9 @@ void VarslamNode::ensure_session(const sensor_msgs::Image& rgb) {
                                             params_.realtime ? varslam::Mode::RealTime : varslam::Mode::Deterministic);
   }
   slam_->add_listener(*this);
+  // Read once: the camera does not change within a session (it is drawn with on every frame's person boxes).
+  intrinsics_ = {std::stod(config_.get("camera.fx")), std::stod(config_.get("camera.fy")),
+                 std::stod(config_.get("camera.cx")), std::stod(config_.get("camera.cy"))};
   if (params_.viewer) {
     varslam::ViewerOptions v;
     v.port = params_.viewer_port;

@@ -17,6 +17,7 @@
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -76,6 +77,7 @@ class VarslamNode : public varslam::Listener {
   NodeParams params_;
   bool have_camera_ = false;  // from ~settings_file or the first CameraInfo
   std::unique_ptr<varslam::Slam> slam_;
+  std::array<double, 4> intrinsics_{1, 1, 0, 0};  // fx fy cx cy of the session's camera
 
   message_filters::Subscriber<sensor_msgs::Image> rgb_sub_, depth_sub_;
   std::unique_ptr<message_filters::Synchronizer<SyncPolicy>> sync_;

@@ -50,11 +50,17 @@ cv::Mat decode_raw_image(const std::string& encoding, std::uint32_t width, std::
                    : bpp == 1                        ? CV_8UC1
                    : bpp == 2                        ? CV_16UC1
                                                      : CV_32FC1;
-  // Rows copied one by one: a step that is not a multiple of the pixel size (legal in a message) cannot be an
-  // OpenCV matrix step (found by fuzzing).
-  cv::Mat view(static_cast<int>(height), static_cast<int>(width), type);
-  for (std::uint32_t y = 0; y < height; ++y)
-    std::memcpy(view.ptr(static_cast<int>(y)), data + static_cast<std::size_t>(step) * y, row);
+  // The message's bytes as a matrix, without a copy. A step that is not a multiple of the element size (legal in a
+  // message) cannot be an OpenCV matrix step (found by fuzzing): such rows are copied one by one.
+  const std::size_t element = static_cast<std::size_t>(CV_ELEM_SIZE1(type));
+  cv::Mat view;
+  if (step % element == 0) {
+    view = cv::Mat(static_cast<int>(height), static_cast<int>(width), type, const_cast<std::uint8_t*>(data), step);
+  } else {
+    view.create(static_cast<int>(height), static_cast<int>(width), type);
+    for (std::uint32_t y = 0; y < height; ++y)
+      std::memcpy(view.ptr(static_cast<int>(y)), data + static_cast<std::size_t>(step) * y, row);
+  }
   cv::Mat out;
   if (encoding == "rgb8") {
     cv::cvtColor(view, out, cv::COLOR_RGB2BGR);
@@ -63,7 +69,7 @@ cv::Mat decode_raw_image(const std::string& encoding, std::uint32_t width, std::
   } else if (encoding == "bgra8" || encoding == "8UC4") {
     cv::cvtColor(view, out, cv::COLOR_BGRA2BGR);
   } else {
-    out = view;
+    out = view.clone();  // owns its data: the message's buffer goes with the message
   }
   if (big_endian && (bpp == 2 || type == CV_32FC1)) {
     for (int y = 0; y < out.rows; ++y) {
