@@ -181,7 +181,10 @@ inline constexpr KeySpec kKeys[] = {
     detail::integer("relocalization.min_score", 25, 1, 256, "signature matches (of 256) for a candidate keyframe"),
     detail::integer("relocalization.candidates", 5, 1, 100, "candidates tried per lost frame"),
     detail::integer("relocalization.min_inliers", 30, 3, 100000, "pose inliers against the candidate keyframe"),
-    detail::integer("relocalization.loaded_map_min_inliers", 15, 3, 100000, "the same for the first fix in a loaded map (the local-map check after it still asks 50 inliers): a place is rarely seen from one keyframe alone"),
+    detail::integer("relocalization.loaded_map_min_inliers", 15, 3, 100000, "the same in a map this session did not build (a loaded map, localization only; the local-map check after it still asks 50 inliers): a place is rarely seen from one keyframe alone"),
+    detail::integer("relocalization.loaded_map_min_score", 12, 1, 256, "relocalization.min_score in a map this session did not build (a loaded map, localization only)"),
+    detail::integer("relocalization.loaded_map_candidates", 20, 1, 1000, "relocalization.candidates in a map this session did not build; candidates inside a neighbourhood already tried are skipped"),
+    detail::integer("relocalization.neighbourhood_keyframes", 10, 0, 1000, "covisible keyframes whose map points join a candidate's when one keyframe alone does not locate the frame in a map this session did not build"),
     detail::integer("relocalization.loaded_map_patience", 90, 1, 1000000,
                     "frames a run started on a loaded map tries to relocalize in it before starting a new segment"),
 

@@ -1,5 +1,7 @@
 #include "slam/keyframe_localization.hpp"
 
+#include <unordered_set>
+
 #include "optim/pose_optimizer.hpp"
 #include "optim/rigid_alignment.hpp"
 #include "slam/ba_problem_builder.hpp"
@@ -27,17 +29,22 @@ int refine_pose_on_matches(Frame& cur, const optim::KernelConfig& kernel) {
   return inliers;
 }
 
-int locate_against_keyframe(Frame& cur, const KeyFrame& kf, const LocalizationConfig& cfg) {
+namespace {
+
+int clear_matches(Frame& cur) {
+  std::fill(cur.map_points.begin(), cur.map_points.end(), nullptr);
+  std::fill(cur.outlier.begin(), cur.outlier.end(), false);
+  return 0;
+}
+
+// Pose from the matches in cur.map_points: rigid 3-D/3-D RANSAC on the ones with depth, then pose-only
+// optimisation on all of them. On failure clears the matches and restores the prior pose.
+int solve_pose_from_matches(Frame& cur, std::uint64_t seed, const LocalizationConfig& cfg) {
   const Eigen::Isometry3d prior = cur.T_cw;
   const auto fail = [&] {
-    std::fill(cur.map_points.begin(), cur.map_points.end(), nullptr);
-    std::fill(cur.outlier.begin(), cur.outlier.end(), false);
     cur.T_cw = prior;
-    return 0;
+    return clear_matches(cur);
   };
-  std::fill(cur.map_points.begin(), cur.map_points.end(), nullptr);
-  if (match_keyframe_by_descriptor(cur, kf) < cfg.min_matches) return fail();
-
   // World points of the matches against the keypoints' own camera-frame points (where depth is valid).
   const FrameFeatures& F = *cur.features;
   std::vector<Eigen::Vector3d> world, camera;
@@ -56,7 +63,7 @@ int locate_against_keyframe(Frame& cur, const KeyFrame& kf, const LocalizationCo
   optim::RigidRansacConfig rc;
   rc.iterations = cfg.ransac_iterations;
   rc.min_inliers = cfg.min_inliers;
-  rc.seed = static_cast<std::uint64_t>(kf.id()) + 1;
+  rc.seed = seed;
   const optim::RigidRansacResult r = optim::estimate_rigid_ransac(world, camera, rc, &tolerance);
   if (!r.ok) return fail();
   // T_ab maps camera points to world points: it is the camera-to-world pose.
@@ -67,6 +74,38 @@ int locate_against_keyframe(Frame& cur, const KeyFrame& kf, const LocalizationCo
   const int inliers = refine_pose_on_matches(cur, cfg.kernel);
   if (inliers < cfg.min_inliers) return fail();
   return inliers;
+}
+
+}  // namespace
+
+int locate_against_keyframe(Frame& cur, const KeyFrame& kf, const LocalizationConfig& cfg) {
+  std::fill(cur.map_points.begin(), cur.map_points.end(), nullptr);
+  if (match_keyframe_by_descriptor(cur, kf) < cfg.min_matches) return clear_matches(cur);
+  return solve_pose_from_matches(cur, static_cast<std::uint64_t>(kf.id()) + 1, cfg);
+}
+
+KeyframeNeighbourhood keyframe_neighbourhood(const KeyFrame& kf, int covisibles) {
+  KeyframeNeighbourhood near;
+  std::unordered_set<const MapPoint*> seen;
+  const auto add = [&](const KeyFrame& k) {
+    for (const auto& mp : k.map_points())
+      if (mp && !mp->is_bad() && seen.insert(mp.get()).second) near.points.push_back(mp);
+  };
+  add(kf);
+  near.keyframe_ids.push_back(kf.id());
+  for (const auto& n : kf.best_covisibles(static_cast<std::size_t>(covisibles))) {
+    if (!n || n->is_bad()) continue;
+    add(*n);
+    near.keyframe_ids.push_back(n->id());
+  }
+  return near;
+}
+
+int locate_against_points(Frame& cur, const std::vector<MapPointPtr>& points, std::uint64_t seed,
+                          const LocalizationConfig& cfg) {
+  std::fill(cur.map_points.begin(), cur.map_points.end(), nullptr);
+  if (match_points_by_descriptor(cur, points) < cfg.min_matches) return clear_matches(cur);
+  return solve_pose_from_matches(cur, seed, cfg);
 }
 
 }  // namespace varslam::slam

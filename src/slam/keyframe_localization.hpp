@@ -21,6 +21,19 @@ struct LocalizationConfig {
 /// inliers; otherwise clears cur.map_points, leaves cur.T_cw as it was and returns 0.
 int locate_against_keyframe(Frame& cur, const KeyFrame& kf, const LocalizationConfig& cfg);
 
+/// A keyframe and its best covisible keyframes, with their map points (each once, in keyframe order).
+struct KeyframeNeighbourhood {
+  std::vector<long> keyframe_ids;
+  std::vector<MapPointPtr> points;
+};
+KeyframeNeighbourhood keyframe_neighbourhood(const KeyFrame& kf, int covisibles);
+
+/// The same against the map points of a keyframe's neighbourhood (`points`, e.g. the keyframe's and its best
+/// covisibles'): a frame between mapped viewpoints sees a place that no single keyframe sees enough of.
+/// `seed` makes the RANSAC deterministic.
+int locate_against_points(Frame& cur, const std::vector<MapPointPtr>& points, std::uint64_t seed,
+                          const LocalizationConfig& cfg);
+
 /// Pose-only optimisation of cur.T_cw on its current matches (outliers dropped from cur.map_points); returns the
 /// inliers. Shared by relocalization and loop verification.
 int refine_pose_on_matches(Frame& cur, const optim::KernelConfig& kernel);

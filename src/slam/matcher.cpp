@@ -21,6 +21,7 @@ constexpr double kFrontalViewCos = 0.998, kFrontalRadius = 2.5, kObliqueRadius =
 constexpr double kSameScaleRatio = 0.8;
 // Nearest-neighbour ratio of the descriptor matching against a keyframe (Lowe's test).
 constexpr double kKeyframeMatchRatio = 0.7;
+constexpr double kNeighbourhoodMatchRatio = 0.9;
 // Fusion gates on the squared reprojection error at the keypoint's scale, 2 and 3 dof, as ORB-SLAM writes them
 // (the 95 % chi-square quantiles 5.991 and 7.815, rounded).
 constexpr double kFuseGateMono = 5.99, kFuseGateStereo = 7.8;
@@ -181,6 +182,26 @@ int match_keyframe_by_descriptor(Frame& cur, const KeyFrame& kf) {
     rot.emplace_back(m.train, K.keypoints[ki].angle - F.keypoints[m.train].angle);
   }
   enforce_rotation_consistency(cur, rot, n);
+  return n;
+}
+
+int match_points_by_descriptor(Frame& cur, const std::vector<MapPointPtr>& points) {
+  const FrameFeatures& F = *cur.features;
+  std::vector<MapPointPtr> usable;
+  usable.reserve(points.size());
+  for (const MapPointPtr& mp : points)
+    if (mp && !mp->is_bad() && !mp->descriptor().empty()) usable.push_back(mp);
+  if (usable.empty() || F.descriptors.empty()) return 0;
+  cv::Mat query(static_cast<int>(usable.size()), F.descriptors.cols, F.descriptors.type());
+  for (std::size_t r = 0; r < usable.size(); ++r) usable[r]->descriptor().copyTo(query.row(static_cast<int>(r)));
+  int n = 0;
+  // Loose on purpose: the points were seen from other viewpoints than this frame's, and the rigid RANSAC on depth
+  // that follows rejects the wrong matches.
+  for (const auto& m : match_descriptors(query, F.descriptors, kDescDistHigh, kNeighbourhoodMatchRatio, true)) {
+    cur.map_points[m.train] = usable[m.query];
+    cur.outlier[m.train] = false;
+    ++n;
+  }
   return n;
 }
 

@@ -30,6 +30,10 @@ int match_local_map(Frame& cur, const std::vector<MapPointPtr>& points, double r
 /// rotation consistency); the fallback when the motion model fails.
 int match_keyframe_by_descriptor(Frame& cur, const KeyFrame& kf);
 
+/// Descriptor matching of map points (their representative descriptors) against all of the frame's keypoints
+/// (ratio test, one point per keypoint), with no pose prior: a place seen from several keyframes at once.
+int match_points_by_descriptor(Frame& cur, const std::vector<MapPointPtr>& points);
+
 /// Projects `points` into `kf` and either adds them as new observations or fuses them with the point
 /// already there (the one with more observations survives). Returns the number fused or added.
 int fuse_into_keyframe(const KeyFramePtr& kf, const std::vector<MapPointPtr>& points, double radius = 3.0);

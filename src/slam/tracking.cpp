@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <unordered_set>
 #include <shared_mutex>
 #include <utility>
 
@@ -102,7 +103,8 @@ TrackOutcome Tracker::track(const RgbdFrame& input) {
   }
 
   bool ok = false;
-  if (state_ == TrackState::Ok) {
+  const bool was_tracked = state_ == TrackState::Ok;
+  if (was_tracked) {
     refresh_last_frame(cur.id);
     ok = track_initial_pose(cur, out.timings);
   } else {
@@ -114,9 +116,11 @@ TrackOutcome Tracker::track(const RgbdFrame& input) {
   if (ok) {
     state_ = TrackState::Ok;
     lost_count_ = 0;
-    // The first pose in a loaded map has no predecessor to take a velocity from.
-    has_velocity_ = !std::exchange(awaiting_loaded_map_, false);
-    velocity_ = has_velocity_ ? cur.T_cw * last_.T_cw.inverse() : Eigen::Isometry3d::Identity();
+    awaiting_loaded_map_ = false;
+    // After a loss (or before the first fix in a loaded map) the last pose was only predicted: no velocity can be
+    // taken from it, and at frame rate standing still is the better guess.
+    velocity_ = was_tracked ? cur.T_cw * last_.T_cw.inverse() : Eigen::Isometry3d::Identity();
+    has_velocity_ = true;
     clean_temporary_matches(cur);
     record_fates(cur, out);
     for (std::size_t i = 0; i < cur.map_points.size(); ++i)
@@ -511,15 +515,29 @@ bool Tracker::recover(Frame& cur, FrameTimings& t) {
 bool Tracker::relocalize(Frame& cur, FrameTimings& t) {
   if (!places_ || !cfg_.relocalization.enabled) return false;
   const auto t0 = Clock::now();
-  const auto candidates = places_->query(places_->signature(*cur.features), cfg_.relocalization.min_score,
-                                         cfg_.relocalization.candidates);
+  const RelocalizationConfig& rc = cfg_.relocalization;
+  // In a map this session did not build (a loaded map, or localization only) the frame is often between mapped
+  // viewpoints, far from any one keyframe: more candidates, fewer inliers asked, and a candidate's covisible
+  // neighbourhood tried as a whole. The local-map check that follows (50 inliers after a recovery) verifies.
+  const bool in_foreign_map = awaiting_loaded_map_ || localization_only_;
+  const auto candidates = places_->query(places_->signature(*cur.features),
+                                         in_foreign_map ? rc.loaded_map_min_score : rc.min_score,
+                                         in_foreign_map ? rc.loaded_map_candidates : rc.candidates);
   LocalizationConfig lc;
-  // The first fix in a loaded map: no earlier pose narrows the candidates, and the local-map check that follows
-  // (track_local_map, 50 inliers after a recovery) verifies the pose against the whole neighbourhood.
-  lc.min_inliers = awaiting_loaded_map_ ? cfg_.relocalization.loaded_map_min_inliers : cfg_.relocalization.min_inliers;
+  lc.min_inliers = in_foreign_map ? rc.loaded_map_min_inliers : rc.min_inliers;
   lc.kernel = cfg_.tracking.kernel;
+  // A neighbourhood's loose matches have a low inlier share: 200 samples often miss a clean one.
+  LocalizationConfig wide = lc;
+  wide.ransac_iterations = 1000;
+  std::unordered_set<long> tried;  // keyframes whose points were already matched in a neighbourhood
   for (const auto& cand : candidates) {
-    const int inliers = locate_against_keyframe(cur, *cand.keyframe, lc);
+    if (tried.contains(cand.keyframe->id())) continue;
+    int inliers = locate_against_keyframe(cur, *cand.keyframe, lc);
+    if (inliers == 0 && in_foreign_map) {
+      const KeyframeNeighbourhood near = keyframe_neighbourhood(*cand.keyframe, rc.neighbourhood_keyframes);
+      tried.insert(near.keyframe_ids.begin(), near.keyframe_ids.end());
+      inliers = locate_against_points(cur, near.points, static_cast<std::uint64_t>(cand.keyframe->id()) + 1, wide);
+    }
     if (inliers == 0) continue;
     t.match_ms += ms_since(t0);
     last_recovery_frame_id_ = cur.id;
