@@ -47,6 +47,15 @@ struct SessionSummary {
   std::string person_detector;  // "none" without the person filter
 };
 
+/// What a frame may bring besides its images.
+struct FrameExtras {
+  /// The people in this image from the caller's own detector (as track(bgr, depth, timestamp, people) takes them).
+  std::optional<std::vector<PersonBox>> people;
+  /// The caller's own segmentation of things that move: CV_8UC1 of the image's size, non-zero on movers. No keypoints
+  /// are taken there, so nothing is tracked on or mapped from them. Empty: none. Applies to this frame only.
+  cv::Mat mover_mask;
+};
+
 class Slam {
  public:
   /// Throws ConfigError for bad settings and InputError when the person detector's model cannot be loaded.
@@ -62,6 +71,8 @@ class Slam {
   TrackedFrame track(const cv::Mat& bgr, const cv::Mat& depth, double timestamp);
   /// The same with the people in this image from the caller's own detector (the person filter uses them as they are).
   TrackedFrame track(const cv::Mat& bgr, const cv::Mat& depth, double timestamp, const std::vector<PersonBox>& people);
+  /// The same with a mover mask and/or person boxes. InputError for a mask of another size or type.
+  TrackedFrame track(const cv::Mat& bgr, const cv::Mat& depth, double timestamp, const FrameExtras& extras);
 
   /// Finishes local mapping and loop closing so the map and camera_trajectory() are final. Later track() calls are
   /// an error (reset() starts again).
@@ -75,6 +86,12 @@ class Slam {
   void load_map(const std::string& file);
   /// Tracks in the map without extending it (no keyframes, no points): the live pose in a known map.
   void set_localization_only(bool on);
+  /// Where the camera is, roughly (camera-to-world in the map's frame: from odometry, or a place picked on the map):
+  /// while tracking is lost, or not yet found in a loaded map, the keyframes within `radius_m` of it are tried first
+  /// and a fix is kept only within `radius_m` of it; the place database is searched after them as usual. Kept until a
+  /// frame is tracked; it does not move a pose that tracking holds. InputError for a non-finite pose, a quaternion far
+  /// from unit length or a radius that is not positive.
+  void relocalize_near(const Pose& camera_to_world, double radius_m = 1.0);
   /// Writes the map (atomically). While running in real-time mode, local mapping pauses until its queue is drained
   /// (about one Local BA) so the copy is consistent; tracking waits meanwhile.
   void save_map(const std::string& file);

@@ -124,7 +124,8 @@ struct Slam::Impl final : Observer {
     return lock;
   }
 
-  TrackedFrame track(const cv::Mat& bgr, const cv::Mat& depth, double t, const std::optional<Detections>& boxes) {
+  TrackedFrame track(const cv::Mat& bgr, const cv::Mat& depth, double t, const std::optional<Detections>& boxes,
+                     const cv::Mat& mover_mask = cv::Mat()) {
     while (waiting.load() > 0) std::this_thread::yield();
     std::lock_guard lock(pipeline_mutex);
     check_timestamp(t);
@@ -133,7 +134,8 @@ struct Slam::Impl final : Observer {
     // (no reference count: cv_bridge's toCvShare, a Mat over a camera driver's memory) is copied first.
     const cv::Mat own_bgr = bgr.u ? bgr : bgr.clone();
     const cv::Mat own_depth = depth.u ? depth : depth.clone();
-    const FrameResult r = pipeline->track(own_bgr, own_depth, t, boxes);
+    const cv::Mat own_mask = mover_mask.u || mover_mask.empty() ? mover_mask : mover_mask.clone();
+    const FrameResult r = pipeline->track(own_bgr, own_depth, t, boxes, own_mask);
     last_timestamp = t;
     TrackedFrame f;
     f.index = r.index;
@@ -212,8 +214,9 @@ TrackedFrame Slam::track(const cv::Mat& bgr, const cv::Mat& depth, double timest
   return impl_->track(bgr, depth, timestamp, std::nullopt);
 }
 
-TrackedFrame Slam::track(const cv::Mat& bgr, const cv::Mat& depth, double timestamp,
-                         const std::vector<PersonBox>& people) {
+namespace {
+
+Detections to_detections(const std::vector<PersonBox>& people, double timestamp) {
   Detections d;
   for (const PersonBox& b : people) {
     if (!std::isfinite(b.x) || !std::isfinite(b.y) || !std::isfinite(b.width) || !std::isfinite(b.height) ||
@@ -222,7 +225,20 @@ TrackedFrame Slam::track(const cv::Mat& bgr, const cv::Mat& depth, double timest
                                    b.width, b.height));
     d.push_back({timestamp, "person", b.score, cv::Rect2f(b.x, b.y, b.width, b.height)});
   }
-  return impl_->track(bgr, depth, timestamp, d);
+  return d;
+}
+
+}  // namespace
+
+TrackedFrame Slam::track(const cv::Mat& bgr, const cv::Mat& depth, double timestamp,
+                         const std::vector<PersonBox>& people) {
+  return impl_->track(bgr, depth, timestamp, to_detections(people, timestamp));
+}
+
+TrackedFrame Slam::track(const cv::Mat& bgr, const cv::Mat& depth, double timestamp, const FrameExtras& extras) {
+  std::optional<Detections> boxes;
+  if (extras.people) boxes = to_detections(*extras.people, timestamp);
+  return impl_->track(bgr, depth, timestamp, boxes, extras.mover_mask);
 }
 
 void Slam::finish() {
@@ -258,6 +274,24 @@ void Slam::set_localization_only(bool on) {
     throw InputError("localization only needs a map to localize in: load_map() first, or track until there is one");
   impl_->pipeline->set_localization_only(on);
   impl_->localization_only = on;
+}
+
+void Slam::relocalize_near(const Pose& camera_to_world, double radius_m) {
+  const auto& t = camera_to_world.translation;
+  const auto& q = camera_to_world.rotation;
+  const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  const bool finite = std::isfinite(t[0]) && std::isfinite(t[1]) && std::isfinite(t[2]) && std::isfinite(norm);
+  if (!finite || std::abs(norm - 1) > 1e-3)
+    throw InputError(fmt::format("relocalize_near: the pose ({}, {}, {}; quaternion {}, {}, {}, {}) is not finite "
+                                 "with a unit quaternion",
+                                 t[0], t[1], t[2], q[0], q[1], q[2], q[3]));
+  if (!std::isfinite(radius_m) || radius_m <= 0)
+    throw InputError(fmt::format("relocalize_near: radius {} m is not a positive distance", radius_m));
+  Eigen::Isometry3d T_wc = Eigen::Isometry3d::Identity();
+  T_wc.linear() = Eigen::Quaterniond(q[3], q[0], q[1], q[2]).normalized().toRotationMatrix();
+  T_wc.translation() = Eigen::Vector3d(t[0], t[1], t[2]);
+  std::lock_guard lock(impl_->pipeline_mutex);
+  impl_->pipeline->relocalize_near(T_wc, radius_m);
 }
 
 void Slam::save_map(const std::string& file) {

@@ -103,6 +103,11 @@ void check_frame(const RgbdFrame& f, const PinholeCamera& cam) {
   if (f.depth.empty() || f.depth.type() != CV_32FC1 || !fits(f.depth))
     throw InputError(fmt::format("Pipeline::track: frame {} needs a CV_32FC1 depth image in metres of {}x{}", f.index,
                                  cam.width, cam.height));
+  if (!f.mover_mask.empty() && (f.mover_mask.type() != CV_8UC1 || !fits(f.mover_mask)))
+    throw InputError(fmt::format("Pipeline::track: frame {}: the mover mask must be CV_8UC1 of {}x{} (it is {}x{}, "
+                                 "type {})",
+                                 f.index, cam.width, cam.height, f.mover_mask.cols, f.mover_mask.rows,
+                                 f.mover_mask.type()));
 }
 
 // Settings built in code (not loaded) get the same whole-document check a file does.
@@ -190,6 +195,8 @@ void Pipeline::start(std::span<const RgbdFrame> samples) {
     pending_map_.reset();
   }
   system_->set_localization_only(localization_only_);
+  if (pending_pose_hint_) system_->set_pose_hint(pending_pose_hint_->first, pending_pose_hint_->second);
+  pending_pose_hint_.reset();
   if (masker_) install_person_filter();
   emit(reg, &Observer::on_depth_registration);
 }
@@ -245,8 +252,10 @@ std::function<void(RgbdFrame&)> Pipeline::frame_preparation() const {
 }
 
 FrameResult Pipeline::track(const cv::Mat& bgr, const cv::Mat& depth, double timestamp,
-                        const std::optional<Detections>& boxes) {
-  return track(frame_from_images(bgr, depth, timestamp, frames_, settings_), boxes);
+                            const std::optional<Detections>& boxes, const cv::Mat& mover_mask) {
+  RgbdFrame frame = frame_from_images(bgr, depth, timestamp, frames_, settings_);
+  frame.mover_mask = mover_mask;
+  return track(frame, boxes);
 }
 
 FrameResult Pipeline::track(const RgbdFrame& input, const std::optional<Detections>& boxes) {
@@ -347,6 +356,11 @@ void Pipeline::set_localization_only(bool on) {
     throw std::logic_error("Pipeline::set_localization_only: there is no map to localize in (load_map() first)");
   localization_only_ = on;
   if (system_) system_->set_localization_only(on);
+}
+
+void Pipeline::relocalize_near(const Eigen::Isometry3d& T_wc, double radius_m) {
+  if (system_) system_->set_pose_hint(T_wc, radius_m);
+  else pending_pose_hint_ = {T_wc, radius_m};
 }
 
 void Pipeline::save_map(const std::filesystem::path& file, const std::optional<Eigen::Isometry3d>& groundtruth_alignment) {

@@ -81,6 +81,9 @@ class Pipeline {
   /// Track against the map without extending it (no keyframes, no points, no new segment): the live pose in a
   /// known map, as a robot uses it. Needs a loaded map when switched on before the first frame.
   void set_localization_only(bool on);
+  /// While tracking is lost (or not yet fixed in a loaded map), relocalize near this camera-to-world pose first
+  /// (slam::Tracker::set_pose_hint). Kept until a frame is tracked.
+  void relocalize_near(const Eigen::Isometry3d& T_wc, double radius_m);
   /// Writes the map (atomically): after finish(), or between track() calls (real-time mode: local mapping is
   /// paused until its queue is drained, then resumed). `groundtruth_alignment` (map frame -> ground-truth frame), when
   /// the caller has one, goes with it so runs in this map can be evaluated in its frame.
@@ -91,9 +94,10 @@ class Pipeline {
 
   /// Tracks one frame. `bgr`: CV_8UC3 (or CV_8UC1 gray); `depth`: CV_16UC1 raw (divided by depth.factor) or
   /// CV_32FC1 metres, 0 = no depth; both of the camera's size. `boxes`: the people in this image from the caller's
-  /// own detector (the person filter then uses them as they are).
+  /// own detector (the person filter then uses them as they are). `mover_mask`: optional CV_8UC1 of the image's
+  /// size, non-zero where movers are (no keypoints are taken there).
   FrameResult track(const cv::Mat& bgr, const cv::Mat& depth, double timestamp,
-                    const std::optional<Detections>& boxes = std::nullopt);
+                    const std::optional<Detections>& boxes = std::nullopt, const cv::Mat& mover_mask = cv::Mat());
   /// The same for a decoded frame (dataset readers): gray CV_8UC1 (bgr optional, for the detector) and depth
   /// CV_32FC1 in metres, of the camera's size; InputError otherwise.
   FrameResult track(const RgbdFrame& frame, const std::optional<Detections>& boxes = std::nullopt);
@@ -139,6 +143,7 @@ class Pipeline {
   std::filesystem::path pending_map_file_;
   std::optional<Eigen::Isometry3d> loaded_alignment_;
   bool localization_only_ = false;
+  std::optional<std::pair<Eigen::Isometry3d, double>> pending_pose_hint_;  // given before the system started
   std::size_t frames_ = 0, tracked_ = 0;
   bool finished_ = false;
 };

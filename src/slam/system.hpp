@@ -40,6 +40,7 @@ class System {
   /// consistent) for the copy and started again. Call from the thread that calls process().
   SavedMap snapshot_now(MapFingerprint fingerprint);
   void set_localization_only(bool on) { tracker_.set_localization_only(on); }
+  void set_pose_hint(const Eigen::Isometry3d& T_wc, double radius_m) { tracker_.set_pose_hint(T_wc, radius_m); }
 
   void set_keypoint_filter(KeypointFilterFn fn) { tracker_.set_keypoint_filter(std::move(fn)); }
   void set_extraction_mask(ExtractionMaskFn fn) { tracker_.set_extraction_mask(std::move(fn)); }

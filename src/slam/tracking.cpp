@@ -44,13 +44,29 @@ Tracker::Tracker(const SlamConfig& cfg, const PinholeCamera& camera, double clos
   scale_ = s;
 }
 
+namespace {
+
+// A neighbourhood's loose matches have a low inlier share: 200 RANSAC samples often miss a clean one.
+constexpr int kNeighbourhoodRansacIterations = 1000;
+
+// The pixels where keypoints may be taken: those `allowed` (all when empty) that the caller's mover mask leaves.
+cv::Mat without_movers(const cv::Mat& allowed, const cv::Mat& movers) {
+  cv::Mat out;
+  cv::compare(movers, 0, out, cv::CMP_EQ);
+  if (!allowed.empty()) cv::bitwise_and(out, allowed, out);
+  return out;
+}
+
+}  // namespace
+
 Frame Tracker::build_frame(const RgbdFrame& input, FrameTimings& t) {
   auto t0 = Clock::now();
   std::vector<cv::KeyPoint> kps;
   cv::Mat desc;
   cv::Mat mask;
-  if (extraction_mask_) {
-    mask = extraction_mask_(input);
+  if (extraction_mask_) mask = extraction_mask_(input);
+  if (!input.mover_mask.empty()) mask = without_movers(mask, input.mover_mask);
+  if (!mask.empty()) {
     t.filter_ms = ms_since(t0);
     t0 = Clock::now();
   }
@@ -117,6 +133,7 @@ TrackOutcome Tracker::track(const RgbdFrame& input) {
     state_ = TrackState::Ok;
     lost_count_ = 0;
     awaiting_loaded_map_ = false;
+    pose_hint_.reset();
     // After a loss (or before the first fix in a loaded map) the last pose was only predicted: no velocity can be
     // taken from it, and at frame rate standing still is the better guess.
     velocity_ = was_tracked ? cur.T_cw * last_.T_cw.inverse() : Eigen::Isometry3d::Identity();
@@ -513,6 +530,12 @@ bool Tracker::recover(Frame& cur, FrameTimings& t) {
 }
 
 bool Tracker::relocalize(Frame& cur, FrameTimings& t) {
+  if (pose_hint_) {
+    const auto t0 = Clock::now();
+    const bool found = relocalize_near_hint(cur);
+    t.match_ms += ms_since(t0);
+    if (found) return true;
+  }
   if (!places_ || !cfg_.relocalization.enabled) return false;
   const auto t0 = Clock::now();
   const RelocalizationConfig& rc = cfg_.relocalization;
@@ -526,9 +549,8 @@ bool Tracker::relocalize(Frame& cur, FrameTimings& t) {
   LocalizationConfig lc;
   lc.min_inliers = in_foreign_map ? rc.loaded_map_min_inliers : rc.min_inliers;
   lc.kernel = cfg_.tracking.kernel;
-  // A neighbourhood's loose matches have a low inlier share: 200 samples often miss a clean one.
   LocalizationConfig wide = lc;
-  wide.ransac_iterations = 1000;
+  wide.ransac_iterations = kNeighbourhoodRansacIterations;
   std::unordered_set<long> tried;  // keyframes whose points were already matched in a neighbourhood
   for (const auto& cand : candidates) {
     if (tried.contains(cand.keyframe->id())) continue;
@@ -540,16 +562,51 @@ bool Tracker::relocalize(Frame& cur, FrameTimings& t) {
     }
     if (inliers == 0) continue;
     t.match_ms += ms_since(t0);
-    last_recovery_frame_id_ = cur.id;
-    reference_kf_ = cand.keyframe;
-    cur.reference_kf = cand.keyframe;
-    ++relocalizations_;
-    relocalized_ = Relocalization{cand.keyframe->id(), inliers, cand.score};
+    accept_relocalization(cur, cand.keyframe, inliers, cand.score);
     spdlog::info("relocalized at t={:.3f} against keyframe {} ({} inliers, place score {})", cur.timestamp,
                  cand.keyframe->id(), inliers, cand.score);
     return true;
   }
   t.match_ms += ms_since(t0);
+  return false;
+}
+
+void Tracker::accept_relocalization(Frame& cur, const KeyFramePtr& kf, int inliers, int score) {
+  last_recovery_frame_id_ = cur.id;
+  reference_kf_ = kf;
+  cur.reference_kf = kf;
+  ++relocalizations_;
+  relocalized_ = Relocalization{kf->id(), inliers, score};
+}
+
+bool Tracker::relocalize_near_hint(Frame& cur) {
+  const Eigen::Vector3d centre = pose_hint_->T_wc.translation();
+  const double radius = pose_hint_->radius_m;
+  std::vector<std::pair<double, KeyFramePtr>> near;  // by distance, then id (keyframes() is ordered by id)
+  for (const auto& kf : map_.keyframes())
+    if (!kf->is_bad() && (kf->camera_center() - centre).norm() <= radius)
+      near.emplace_back((kf->camera_center() - centre).norm(), kf);
+  std::stable_sort(near.begin(), near.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  LocalizationConfig lc;
+  lc.min_inliers = cfg_.relocalization.loaded_map_min_inliers;
+  lc.kernel = cfg_.tracking.kernel;
+  lc.ransac_iterations = kNeighbourhoodRansacIterations;
+  std::unordered_set<long> tried;
+  for (const auto& [distance, kf] : near) {
+    if (tried.contains(kf->id())) continue;
+    const KeyframeNeighbourhood hood = keyframe_neighbourhood(*kf, cfg_.relocalization.neighbourhood_keyframes);
+    tried.insert(hood.keyframe_ids.begin(), hood.keyframe_ids.end());
+    const int inliers = locate_against_points(cur, hood.points, static_cast<std::uint64_t>(kf->id()) + 1, lc);
+    if (inliers == 0) continue;
+    if ((cur.T_cw.inverse().translation() - centre).norm() > radius) {  // a fix elsewhere: not where we were told
+      std::fill(cur.map_points.begin(), cur.map_points.end(), nullptr);
+      continue;
+    }
+    accept_relocalization(cur, kf, inliers, 0);
+    spdlog::info("relocalized at t={:.3f} near the given pose, against keyframe {} ({} inliers)", cur.timestamp,
+                 kf->id(), inliers);
+    return true;
+  }
   return false;
 }
 

@@ -95,6 +95,10 @@ class Tracker {
   /// (a lost frame stays lost until relocalization finds it). May be switched at any frame.
   void set_localization_only(bool on) { localization_only_ = on; }
   bool localization_only() const { return localization_only_; }
+  /// Where the caller says the camera is (world frame, e.g. from odometry or a click on the map): while not tracking,
+  /// relocalization tries the keyframes within `radius_m` of it first and keeps a fix only within `radius_m`. Kept
+  /// until a frame is tracked.
+  void set_pose_hint(const Eigen::Isometry3d& T_wc, double radius_m) { pose_hint_ = PoseHint{T_wc, radius_m}; }
   long next_frame_id() const { return next_frame_id_; }
 
   TrackState state() const { return state_; }
@@ -119,6 +123,8 @@ class Tracker {
   bool recover(Frame& cur, FrameTimings& t);
   /// Global relocalization: place candidates from the database, each located by descriptor matches + RANSAC.
   bool relocalize(Frame& cur, FrameTimings& t);
+  bool relocalize_near_hint(Frame& cur);
+  void accept_relocalization(Frame& cur, const KeyFramePtr& kf, int inliers, int score);
   bool track_local_map(Frame& cur, FrameTimings& t);
   int optimize_and_discard(Frame& cur, FrameTimings& t);
   /// The near-mover check (slam/near_mover.hpp) on a solved frame: when the near matches move against the far
@@ -175,6 +181,11 @@ class Tracker {
   int relocalizations_ = 0;
   long near_mover_frames_ = 0;
   MoverTrack mover_track_;  // the near mover being followed (slam/mover_track.hpp)
+  struct PoseHint {
+    Eigen::Isometry3d T_wc;
+    double radius_m;
+  };
+  std::optional<PoseHint> pose_hint_;
   std::optional<Relocalization> relocalized_;  // of the frame being tracked, moved into its TrackOutcome
   long seen_corrections_ = 0;  // map_.corrections() when the last frame was last re-anchored
   std::vector<KeyFramePtr> local_keyframes_;

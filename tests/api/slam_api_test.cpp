@@ -95,6 +95,40 @@ TEST(ApiSlam, BadTimestampsAndImagesAreInputErrorsAndTheSessionGoesOn) {
   for (const auto& p : slam.live_trajectory()) EXPECT_TRUE(std::isfinite(p.pose.translation[0]));
 }
 
+// A mover mask keeps keypoints off its pixels: the first frame's map (world = that camera's frame) holds no point
+// that projects into the masked left half, and a mask over the whole image leaves nothing to track.
+TEST(ApiSlam, AMoverMaskKeepsTheMapOffItsPixels) {
+  const auto& f = sequence().frames[0];
+  const double fx = std::stod(sequence().config.get("camera.fx")), cx = std::stod(sequence().config.get("camera.cx"));
+  varslam::FrameExtras left;
+  left.mover_mask = cv::Mat::zeros(f.bgr.size(), CV_8UC1);
+  left.mover_mask.colRange(0, f.bgr.cols / 2).setTo(255);
+  {
+    varslam::Slam slam(sequence().config);
+    ASSERT_TRUE(slam.track(f.bgr, f.depth, f.timestamp, left).pose);
+    const auto map = slam.map_snapshot();
+    ASSERT_GT(map->points.size(), 50u);
+    for (const auto& p : map->points) EXPECT_GE(fx * p.position[0] / p.position[2] + cx, f.bgr.cols / 2 - 1.0);
+  }
+  {
+    varslam::Slam unmasked(sequence().config);
+    ASSERT_TRUE(unmasked.track(f.bgr, f.depth, f.timestamp).pose);
+    std::size_t on_left = 0;
+    for (const auto& p : unmasked.map_snapshot()->points) on_left += fx * p.position[0] / p.position[2] + cx < 300;
+    EXPECT_GT(on_left, 50u);  // so the masked run's empty left half is the mask's doing
+  }
+  varslam::Slam slam(sequence().config);
+  varslam::FrameExtras all;
+  all.mover_mask = cv::Mat(f.bgr.size(), CV_8UC1, cv::Scalar(1));
+  const varslam::TrackedFrame masked = slam.track(f.bgr, f.depth, f.timestamp, all);
+  EXPECT_EQ(masked.keypoints, 0);
+  EXPECT_FALSE(masked.pose);
+  varslam::FrameExtras wrong;
+  wrong.mover_mask = cv::Mat::zeros(10, 10, CV_8UC1);
+  EXPECT_THAT(input_error([&] { slam.track(f.bgr, f.depth, f.timestamp + 1, wrong); }), HasSubstr("mover mask"));
+  EXPECT_TRUE(slam.track(f.bgr, f.depth, f.timestamp + 1).pose);  // the session goes on
+}
+
 // The views other threads may read while track() runs, read as fast as they come (ThreadSanitizer runs this).
 TEST(ApiSlam, AConsumerThreadReadsTheMapAndTrajectoryWhileTracking) {
   varslam::Slam slam(sequence().config, varslam::Mode::RealTime);
@@ -148,6 +182,46 @@ TEST(ApiSlam, AMapSavedWhileRunningIsFoundAgainAndResetStartsOver) {
     localized += again.track(fr[i].bgr, fr[i].depth, fr[i].timestamp).pose ? 1 : 0;
   EXPECT_GT(localized, (fr.size() - 5) * 9 / 10);
   EXPECT_EQ(again.summary().keyframes, again.map_snapshot()->keyframes.size());
+  fs::remove(map);
+}
+
+// With the place database unable to find anything (a score no frame reaches), a loaded map is found only through
+// the caller's hint, there and only there.
+TEST(ApiSlam, RelocalizeNearFindsThePlaceThatTheHintGives) {
+  const auto& fr = sequence().frames;
+  const fs::path map = fs::temp_directory_path() / ("varslam_hint_" + std::to_string(::getpid()) + ".map");
+  varslam::Pose at30;
+  {
+    varslam::Slam slam(sequence().config);
+    for (std::size_t i = 0; i < fr.size(); ++i) {
+      const auto f = slam.track(fr[i].bgr, fr[i].depth, fr[i].timestamp);
+      if (i == 30) at30 = f.pose.value();
+    }
+    slam.finish();
+    slam.save_map(map.string());
+  }
+  varslam::Config blind = sequence().config;
+  blind.set("relocalization.loaded_map_min_score", 256.0);
+  const auto session = [&](const std::optional<varslam::Pose>& hint) {
+    varslam::Slam slam(blind);
+    slam.load_map(map.string());
+    slam.set_localization_only(true);
+    if (hint) slam.relocalize_near(*hint, 0.5);
+    return slam.track(fr[30].bgr, fr[30].depth, fr[30].timestamp);
+  };
+  EXPECT_FALSE(session(std::nullopt).pose);
+  const varslam::TrackedFrame found = session(at30);
+  ASSERT_TRUE(found.pose);
+  EXPECT_TRUE(found.relocalized);
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(found.pose->translation[k], at30.translation[k], 0.02);
+  varslam::Pose elsewhere = at30;
+  elsewhere.translation[0] += 3;
+  EXPECT_FALSE(session(elsewhere).pose);
+  varslam::Slam slam(blind);
+  EXPECT_THAT(input_error([&] { slam.relocalize_near(at30, -1); }), HasSubstr("radius"));
+  varslam::Pose bad = at30;
+  bad.rotation = {0, 0, 0, 2};
+  EXPECT_THAT(input_error([&] { slam.relocalize_near(bad); }), HasSubstr("unit quaternion"));
   fs::remove(map);
 }
 
