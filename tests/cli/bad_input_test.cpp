@@ -14,6 +14,8 @@
 #include <sstream>
 #include <thread>
 
+#include <fmt/format.h>
+
 #include "slam/e2e_support.hpp"
 
 namespace varslam {
@@ -161,6 +163,46 @@ TEST(BadInput, GroundTruthProblemsAreFoundBeforeTheRun) {
   const Outcome folder = cli(run_on(base_sequence(), "gt_folder", "--groundtruth " + seq.string()));
   EXPECT_EQ(folder.exit_code, 2) << folder.output;
   EXPECT_THAT(folder.output, HasSubstr("is a folder"));
+}
+
+// Every fifth ground-truth pose given twice, the copy 0.5 m off: an ATE against it is garbage, so every command
+// that reads ground truth refuses it, naming the file and both lines.
+TEST(BadInput, GroundTruthRepeatingAStampWithAnotherPoseIsRefusedEverywhere) {
+  const fs::path seq = copy_of_base("repeated_gt");
+  std::istringstream in(slurp(base_sequence() / "groundtruth.txt"));
+  std::string text, line;
+  int lines = 0, first_copy = 0;
+  for (int poses = 0; std::getline(in, line);) {
+    text += line + "\n";
+    ++lines;
+    if (line.empty() || line[0] == '#' || ++poses % 5 != 0) continue;
+    std::istringstream ss(line);
+    std::string stamp;
+    double x = 0;
+    ss >> stamp >> x;
+    std::string rest;
+    std::getline(ss, rest);
+    text += stamp + " " + std::to_string(x + 0.5) + rest + "\n";
+    if (++lines && first_copy == 0) first_copy = lines;
+  }
+  std::ofstream(seq / "groundtruth.txt") << text;
+  const std::string gt = (seq / "groundtruth.txt").string();
+  const std::string expect = fmt::format("{}:{}: timestamp", gt, first_copy);
+  const std::string both = fmt::format("lines {} and {}", first_copy - 1, first_copy);
+
+  const Outcome run = cli(run_on(seq, "repeated_gt"));
+  EXPECT_EQ(run.exit_code, 2) << run.output;
+  EXPECT_THAT(run.output, AllOf(HasSubstr(expect), HasSubstr("is also on line"), HasSubstr(both)));
+  const Outcome eval = cli("eval --gt " + gt + " --est " + (base_sequence() / "groundtruth.txt").string());
+  EXPECT_EQ(eval.exit_code, 2) << eval.output;
+  EXPECT_THAT(eval.output, AllOf(HasSubstr(expect), HasSubstr(both)));
+  // The report of a good run drawn against it says so instead of plotting a wrong error.
+  const fs::path good = out_dir("repeated_gt_good");
+  ASSERT_EQ(cli("run -q -d " + base_sequence().string() + " -o " + good.string()).exit_code, 0);
+  const Outcome report = cli("report --run " + good.string() + " --sequence " + seq.string());
+  EXPECT_EQ(report.exit_code, 0) << report.output;
+  EXPECT_THAT(report.output, HasSubstr(expect));
+  EXPECT_THAT(slurp(good / "report.html"), HasSubstr("is also on line"));
 }
 
 TEST(BadInput, OneFrameRunSaysWhyThereIsNoAte) {
