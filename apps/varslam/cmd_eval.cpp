@@ -8,6 +8,7 @@
 #include "commands.hpp"
 #include "core/error.hpp"
 #include "eval/eval_report.hpp"
+#include "io/atomic_file.hpp"
 #include "io/frame_list.hpp"
 #include "io/trajectory_io.hpp"
 #include "mapfile/map_file.hpp"
@@ -67,9 +68,7 @@ void run_eval(const EvalArgs& a) {
   if (!a.json.empty()) {
     nlohmann::json j = eval_to_json(summary, a.per_pair);
     j["files"] = {{"gt", a.gt}, {"est", a.est}};
-    std::ofstream out(a.json);
-    out << j.dump(2) << '\n';
-    if (!out) throw InputError(a.json + ": cannot write the JSON report");
+    write_file_atomically(a.json, j.dump(2) + "\n", "JSON report");
     std::printf("wrote %s\n", a.json.c_str());
   }
   if (!a.plot.empty()) {

@@ -2,12 +2,14 @@
 
 #include <fmt/format.h>
 
+#include <cerrno>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
 #include "core/error.hpp"
+#include "io/file_problem.hpp"
 
 namespace varslam {
 
@@ -23,7 +25,7 @@ void for_each_data_line(const std::filesystem::path& file, const std::string& wh
   if (std::filesystem::is_directory(file, ec))
     throw InputError(fmt::format("{}: is a folder; expected a {}", file.string(), what));
   std::ifstream in(file);
-  if (!in) throw InputError(fmt::format("{}: cannot open {}", file.string(), what));
+  if (!in) throw InputError(fmt::format("{}: cannot open {}: {}", file.string(), what, describe_errno(errno)));
   std::string line;
   TextLine tl;
   tl.text = &line;

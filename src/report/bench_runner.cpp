@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "io/atomic_file.hpp"
 #include "eval/ate.hpp"
 #include "eval/drag_events.hpp"
 #include "io/trajectory_io.hpp"
@@ -33,11 +34,7 @@ std::string read_text(const fs::path& file) {
   return s.str();
 }
 
-void write_text(const fs::path& file, const std::string& text) {
-  std::ofstream out(file);
-  out << text;
-  if (!out) throw InputError(file.string() + ": cannot write");
-}
+void write_text(const fs::path& file, const std::string& text) { write_file_atomically(file, text, "benchmark file"); }
 
 std::string now_iso8601() {
   const std::time_t t = std::time(nullptr);
@@ -341,7 +338,7 @@ BenchOutcome run_benchmark(const BenchOptions& o) {
       {"failed_runs", result.failed},
       {"table_markdown", result.table_markdown}};
 
-  std::ofstream(out / "results.json") << result.results.dump(1) << '\n';
+  write_text(out / "results.json", result.results.dump(1) + "\n");
   const std::string header =
       fmt::format("Benchmark {} ({}), {} runs ({} failed) in {:.0f} s on {}; load average {:.1f} at the start.\n\n",
                   version, started, result.runs, result.failed, result.wall_seconds, describe(machine_start),

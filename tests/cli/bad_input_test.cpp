@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
@@ -24,6 +25,7 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::AllOf;
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 const std::string kCli = std::string(VARSLAM_BINARY_DIR) + "/bin/varslam";
 
@@ -203,6 +205,43 @@ TEST(BadInput, GroundTruthRepeatingAStampWithAnotherPoseIsRefusedEverywhere) {
   EXPECT_EQ(report.exit_code, 0) << report.output;
   EXPECT_THAT(report.output, HasSubstr(expect));
   EXPECT_THAT(slurp(good / "report.html"), HasSubstr("is also on line"));
+}
+
+// A file the system refuses is named with the reason in plain words, wherever it is read or written: a full disk
+// (/dev/full), a symlink loop among the frames (skipped like any unreadable frame, not an internal error), a
+// permission (below; only testable when not root: root reads everything).
+TEST(BadInput, FileProblemsAreNamedInPlainWords) {
+  const std::string gt = (base_sequence() / "groundtruth.txt").string();
+  const Outcome full = cli("eval --gt " + gt + " --est " + gt + " --json /dev/full");
+  EXPECT_EQ(full.exit_code, 2) << full.output;
+  EXPECT_THAT(full.output, HasSubstr("/dev/full: cannot write the JSON report: the disk is full"));
+
+  const fs::path seq = copy_of_base("symlink_loop");
+  std::vector<fs::path> frames;
+  for (const auto& e : fs::directory_iterator(seq / "rgb")) frames.push_back(e.path());
+  std::sort(frames.begin(), frames.end());
+  const fs::path looped = frames.at(5);
+  fs::remove(looped);
+  fs::create_symlink(seq / "rgb" / "b", seq / "rgb" / "a");
+  fs::create_symlink(seq / "rgb" / "a", seq / "rgb" / "b");
+  fs::create_symlink("a", looped);
+  const Outcome loop = cli(run_on(seq, "symlink_loop", "--min-tracked-share 0"));
+  EXPECT_EQ(loop.exit_code, 0) << loop.output;
+  EXPECT_THAT(loop.output, AllOf(HasSubstr(looped.string()), HasSubstr("a loop of symbolic links")));
+  EXPECT_THAT(slurp(out_path("symlink_loop") / "metrics.json"), HasSubstr("a loop of symbolic links"));
+}
+
+TEST(BadInput, DepthImageWithoutReadPermissionIsSkippedAsPermissionDenied) {
+  if (::geteuid() == 0) GTEST_SKIP() << "running as root: permissions cannot be tested";
+  const fs::path locked = copy_of_base("locked_depth");
+  std::vector<fs::path> depths;
+  for (const auto& e : fs::directory_iterator(locked / "depth")) depths.push_back(e.path());
+  std::sort(depths.begin(), depths.end());
+  fs::permissions(depths.at(3), fs::perms::none);
+  const Outcome perm = cli(run_on(locked, "locked_depth", "--min-tracked-share 0"));
+  EXPECT_EQ(perm.exit_code, 0) << perm.output;
+  EXPECT_THAT(perm.output, AllOf(HasSubstr(depths.at(3).string()), HasSubstr("permission denied")));
+  EXPECT_THAT(perm.output, Not(HasSubstr("not a PNG or JPEG")));
 }
 
 TEST(BadInput, OneFrameRunSaysWhyThereIsNoAte) {
