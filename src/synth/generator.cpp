@@ -60,7 +60,9 @@ void prepare_dir(const fs::path& dir) {
     throw InputError(fmt::format("{}: output path exists and is not a folder", dir.string()));
   if (fs::exists(dir) && !fs::is_empty(dir)) {
     if (!fs::exists(dir / "scenario.json"))
-      throw InputError(fmt::format("{}: output folder is not empty and is not an earlier synth output", dir.string()));
+      throw InputError(fmt::format("{}: output folder is not empty and is not an earlier synth output (no "
+                                   "scenario.json); synth would mix its files with the ones there: give another --out",
+                                   dir.string()));
     fs::remove_all(dir / "rgb");
     fs::remove_all(dir / "depth");
   }

@@ -281,17 +281,17 @@ TEST(BadInput, AbsurdCoordinatesAndBoxValuesAreRejected) {
 
 TEST(BadInput, AnEarlierRunsOutputsAreClearedAndAConcurrentRunIsRefused) {
   const fs::path out = out_dir("reused");
-  fs::create_directories(out);
-  std::ofstream(out / "report.html") << "old";
-  std::ofstream(out / "CameraTrajectory_aligned.txt") << "old";
+  ASSERT_EQ(cli("run -q -d " + base_sequence().string() + " -o " + out.string()).exit_code, 0);
+  ASSERT_TRUE(fs::exists(out / "CameraTrajectory_aligned.txt"));
   std::ofstream(out / "notes.txt") << "mine";
   // A run without ground truth leaves no aligned trajectory: the old one must not stay behind.
   const fs::path seq = copy_of_base("no_gt");
   fs::remove(seq / "groundtruth.txt");
+  const std::string old_report = slurp(out / "report.html");
   const Outcome r = cli("run -q -d " + seq.string() + " -o " + out.string());
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_FALSE(fs::exists(out / "CameraTrajectory_aligned.txt"));
-  EXPECT_NE(slurp(out / "report.html"), "old");
+  EXPECT_NE(slurp(out / "report.html"), old_report);
   EXPECT_EQ(slurp(out / "notes.txt"), "mine") << "files that are not ours stay";
 
   const int fd = ::open((out / ".varslam.lock").c_str(), O_RDWR | O_CREAT, 0644);
@@ -300,6 +300,38 @@ TEST(BadInput, AnEarlierRunsOutputsAreClearedAndAConcurrentRunIsRefused) {
   ::close(fd);
   EXPECT_EQ(second.exit_code, 2) << second.output;
   EXPECT_THAT(second.output, HasSubstr("another varslam run is writing into this folder"));
+}
+
+// Only files a varslam command wrote (its .varslam-outputs lists them) are removed or overwritten; files of the
+// user's under an output's name stop every command that writes into a folder, naming the folder and the files.
+TEST(BadInput, FilesOfTheUserInAnOutputFolderAreNeverRemoved) {
+  const fs::path out = out_dir("users_files");
+  fs::create_directories(out);
+  for (const char* name : {"report.html", "metrics.json", "semantic_stages_000003.png"}) std::ofstream(out / name) << "mine";
+  const Outcome run = cli("run -q -d " + base_sequence().string() + " -o " + out.string() + " --debug-frames 3");
+  EXPECT_EQ(run.exit_code, 2) << run.output;
+  EXPECT_THAT(run.output, AllOf(HasSubstr(out.string() + ": holds metrics.json, report.html, semantic_stages_000003.png "
+                                                         "that no varslam run wrote there"),
+                                HasSubstr("give another --out")));
+  for (const char* name : {"report.html", "metrics.json", "semantic_stages_000003.png"})
+    EXPECT_EQ(slurp(out / name), "mine") << name;
+  EXPECT_FALSE(fs::exists(out / "CameraTrajectory.txt")) << "the run should not have started";
+
+  // The same for a report written into a folder of the user's, and for a benchmark's summary files.
+  const fs::path run_dir = out_dir("users_report");
+  ASSERT_EQ(cli("run -q -d " + base_sequence().string() + " -o " + run_dir.string()).exit_code, 0);
+  fs::remove(run_dir / ".varslam-outputs");
+  const Outcome report = cli("report --run " + run_dir.string());
+  EXPECT_EQ(report.exit_code, 2) << report.output;
+  EXPECT_THAT(report.output, HasSubstr(run_dir.string() + ": holds report.html that no varslam run wrote there"));
+  const fs::path bench = out_dir("users_bench");
+  fs::create_directories(bench);
+  std::ofstream(bench / "table.md") << "mine";
+  const Outcome b = cli("bench --scenarios static --paths builtin --seeds 1 --seconds 0.5 --configs huber -j 1 --out " +
+                        bench.string());
+  EXPECT_EQ(b.exit_code, 2) << b.output;
+  EXPECT_THAT(b.output, HasSubstr(bench.string() + ": holds table.md that no varslam run wrote there"));
+  EXPECT_EQ(slurp(bench / "table.md"), "mine");
 }
 
 TEST(BadInput, SigintStopsTheRunCleanlyAndKeepsWhatWasTracked) {
