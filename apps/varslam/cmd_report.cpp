@@ -1,6 +1,7 @@
 // `varslam report`: one self-contained HTML page for a finished run (plots, numbers, preview image).
 #include <fmt/format.h>
 
+#include "cli_common.hpp"
 #include "commands.hpp"
 #include "io/file_problem.hpp"
 #include "io/output_folder.hpp"
@@ -18,7 +19,7 @@ void add_report_command(CLI::App& app) {
   cmd->add_option("--sequence", o->sequence,
                   "Sequence folder (ground truth, preview.png); default: the dataset recorded in metrics.json")
       ->check(CLI::ExistingDirectory);
-  cmd->add_option("--out", o->out, "HTML file to write (default: <run>/report.html)");
+  cmd->add_option("--out", o->out, "HTML file to write (default: <run>/report.html)")->check(kNonEmptyPath);
   cmd->callback([o] {
     const std::filesystem::path out = o->out.empty() ? std::filesystem::path(o->run) / "report.html" : std::filesystem::path(o->out.c_str());
     // Into the run folder only over a report of ours; a file the user names with --out is theirs to replace.

@@ -12,6 +12,7 @@
 #include "eval/drag_events.hpp"
 #include "eval/rpe.hpp"
 #include "io/atomic_file.hpp"
+#include "io/file_problem.hpp"
 #include "io/output_folder.hpp"
 #include "io/trajectory_io.hpp"
 #include "run/filter_stage_writer.hpp"
@@ -160,6 +161,7 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const RunO
   if (options.groundtruth && !std::filesystem::exists(*options.groundtruth))
     throw InputError(fmt::format("{}: ground truth file not found", options.groundtruth->string()));
   if (gt_path && std::filesystem::exists(*gt_path)) groundtruth = read_tum_trajectory(*gt_path);
+  if (options.save_map) check_output_file(*options.save_map, "map");
 
   const OutputFolder out(out_dir, run_outputs(options));
   Pipeline slam(settings, PipelineOptions{options.mode, nullptr});
@@ -260,10 +262,18 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const RunO
     // A map built on a loaded one keeps the loaded map's frame, and so its alignment.
     const auto map_alignment = slam.loaded_map_alignment() ? slam.loaded_map_alignment() : alignment;
     const auto t0 = Clock::now();
-    slam.save_map(*options.save_map, map_alignment);
-    m["map_file"] = {{"path", options.save_map->string()},
-                     {"bytes", std::filesystem::file_size(*options.save_map)},
-                     {"save_ms", std::chrono::duration<double, std::milli>(Clock::now() - t0).count()}};
+    try {
+      slam.save_map(*options.save_map, map_alignment);
+      std::error_code ec;  // a device (/dev/null) has no size
+      const auto bytes = std::filesystem::file_size(*options.save_map, ec);
+      m["map_file"] = {{"path", options.save_map->string()},
+                       {"bytes", ec ? 0 : bytes},
+                       {"save_ms", std::chrono::duration<double, std::milli>(Clock::now() - t0).count()}};
+    } catch (const InputError& e) {
+      // The run's results are still worth having: metrics and report are written, then the command fails.
+      sum.map_error = e.what();
+      m["map_file"] = {{"path", options.save_map->string()}, {"error", e.what()}};
+    }
   }
   write_file_atomically(out_dir / "metrics.json", m.dump(2) + "\n", "metrics file");
   return sum;

@@ -44,6 +44,7 @@ struct RunSummary {
   std::string ate_note;          // why there is no ATE although ground truth exists
   std::optional<std::string> failure;  // the run tracked too little: the share and the likely cause
   bool interrupted = false;      // stopped through RunOptions::stop; the outputs hold what was tracked
+  std::optional<std::string> map_error;  // RunOptions::save_map could not be written (checked before the run too)
   nlohmann::json metrics;
   std::filesystem::path out_dir;
 };

@@ -244,6 +244,46 @@ TEST(BadInput, DepthImageWithoutReadPermissionIsSkippedAsPermissionDenied) {
   EXPECT_THAT(perm.output, Not(HasSubstr("not a PNG or JPEG")));
 }
 
+// An output that cannot be written is found before the run, not after it; an option's bad value is named with
+// the option; a message says what is wrong, not a guess (RPE on a short run, the viewer's address, a BOM).
+TEST(BadInput, OutputsAreCheckedBeforeTheRunAndOptionsAreNamed) {
+  const std::string seq = base_sequence().string();
+  struct Case {
+    std::string args, expect;
+  };
+  for (const Case& c : {Case{"--save-map /nonexistent/dir/m.map", "the folder /nonexistent/dir does not exist"},
+                        Case{"--save-map " + fs::temp_directory_path().string(), "cannot write the map: it is a folder"},
+                        Case{"--save-map /proc/m.map", "cannot create files in /proc"},
+                        Case{"-n 0", "--max-frames: expected a whole number of frames, 1 or more, got '0'"},
+                        Case{"--first 5000", "--first 5000: the dataset has 30 frames"},
+                        Case{"--viewer --viewer-address 999.1.1.1", "--viewer-address: '999.1.1.1' is not an IPv4 address"}}) {
+    const fs::path out = out_dir("early");
+    const Outcome r = cli("run -q -d " + seq + " -o " + out.string() + " " + c.args);
+    EXPECT_EQ(r.exit_code, 2) << c.args << "\n" << r.output;
+    EXPECT_THAT(r.output, HasSubstr(c.expect)) << c.args;
+    EXPECT_FALSE(fs::exists(out / "CameraTrajectory.txt")) << c.args << ": the run should not have started";
+  }
+  EXPECT_THAT(cli("run -q -d '' -o " + out_dir("empty_d").string()).output, HasSubstr("--dataset: expected a path"));
+  EXPECT_THAT(cli("run -q -d " + seq + " -o ''").output, HasSubstr("--out: expected a path"));
+
+  // Saving the map still fails at the end (a full disk): the metrics and the report are there, the command fails.
+  const fs::path out = out_dir("map_full");
+  const Outcome full = cli("run -q -d " + seq + " -o " + out.string() + " --save-map /dev/full");
+  EXPECT_EQ(full.exit_code, 2) << full.output;
+  EXPECT_THAT(full.output, HasSubstr("--save-map: /dev/full: cannot write the map: the disk is full"));
+  EXPECT_THAT(slurp(out / "metrics.json"), HasSubstr("the disk is full"));
+  EXPECT_TRUE(fs::exists(out / "report.html"));
+
+  // A run shorter than the RPE delta says so (the sequence is 1 s, its poses span 0.97 s).
+  EXPECT_THAT(full.output, HasSubstr("too short for RPE at a delta of 1 s: its poses span 0.97 s"));
+
+  // A UTF-8 byte-order mark before rgb.txt's first line (a Windows editor's) is no part of the text.
+  const fs::path bom = copy_of_base("bom");
+  std::ofstream(bom / "rgb.txt") << "\xEF\xBB\xBF" << slurp(base_sequence() / "rgb.txt");
+  const Outcome b = cli(run_on(bom, "bom"));
+  EXPECT_EQ(b.exit_code, 0) << b.output;
+}
+
 TEST(BadInput, OneFrameRunSaysWhyThereIsNoAte) {
   const Outcome r = cli(run_on(base_sequence(), "one_frame", "-n 1"));
   EXPECT_EQ(r.exit_code, 0) << r.output;
