@@ -28,16 +28,23 @@ constexpr double kSameMeasurementDeg = 1.0;
 // Refuses a repeated timestamp whose pose is not the one before it, naming both lines.
 void check_repeat_is_same_pose(const std::filesystem::path& file, const StampedPose& before, int before_line,
                                const StampedPose& again, int again_line) {
-  const double metres = (again.T_wc.translation() - before.T_wc.translation()).norm();
-  const double degrees =
-      Eigen::AngleAxisd(before.T_wc.linear().transpose() * again.T_wc.linear()).angle() * 180.0 / std::numbers::pi;
-  if (metres <= kSameMeasurementM && degrees <= kSameMeasurementDeg) return;
+  const PoseGap gap = pose_gap(before, again);
+  if (is_same_measurement(gap)) return;
   throw InputError(fmt::format("{}:{}: timestamp {:.6f} is also on line {} with another pose ({:.3f} m and {:.2f} deg "
                                "away); a timestamp may repeat only its pose: remove the wrong one of lines {} and {}",
-                               file.string(), again_line, again.timestamp, before_line, metres, degrees, before_line,
-                               again_line));
+                               file.string(), again_line, again.timestamp, before_line, gap.metres, gap.degrees,
+                               before_line, again_line));
 }
 }  // namespace
+
+PoseGap pose_gap(const StampedPose& a, const StampedPose& b) {
+  return {(b.T_wc.translation() - a.T_wc.translation()).norm(),
+          Eigen::AngleAxisd(a.T_wc.linear().transpose() * b.T_wc.linear()).angle() * 180.0 / std::numbers::pi};
+}
+
+bool is_same_measurement(const PoseGap& gap) {
+  return gap.metres <= kSameMeasurementM && gap.degrees <= kSameMeasurementDeg;
+}
 
 Trajectory read_tum_trajectory(const std::filesystem::path& file) {
   Trajectory out;
