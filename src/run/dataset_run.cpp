@@ -161,9 +161,9 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const RunO
   if (options.groundtruth && !std::filesystem::exists(*options.groundtruth))
     throw InputError(fmt::format("{}: ground truth file not found", options.groundtruth->string()));
   if (gt_path && std::filesystem::exists(*gt_path)) groundtruth = read_tum_trajectory(*gt_path);
-  if (options.save_map) check_output_file(*options.save_map, "map");
 
   const OutputFolder out(out_dir, run_outputs(options));
+  if (options.save_map) check_output_file(*options.save_map, "map");  // after the folder: the map may go into it
   Pipeline slam(settings, PipelineOptions{options.mode, nullptr});
   MetricsRecorder metrics;
   slam.add_observer(metrics);
