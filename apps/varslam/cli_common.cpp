@@ -3,6 +3,8 @@
 
 #include <fmt/format.h>
 
+#include <arpa/inet.h>
+#include <netdb.h>
 #include <signal.h>
 #include <spdlog/spdlog.h>
 
@@ -33,6 +35,48 @@ const std::atomic<bool>& stop_on_signals() {
 
 void wait_for_stop() {
   while (!g_stop_requested.load()) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+}
+
+const CLI::Validator kNonEmptyPath(
+    [](std::string& v) { return v.empty() ? std::string("expected a path, got an empty string") : std::string(); },
+    "PATH");
+
+namespace {
+std::string whole_number_at_least(const std::string& v, int least) {
+  const bool digits = !v.empty() && v.find_first_not_of("0123456789") == std::string::npos;
+  if (digits && (least == 0 || v.find_first_not_of('0') != std::string::npos)) return {};
+  return fmt::format("expected a whole number of frames, {} or more, got '{}'", least, v);
+}
+
+// A dotted quad out of range (999.1.1.1) would otherwise go to the resolver as a host name.
+bool looks_like_ipv4(const std::string& v) { return !v.empty() && v.find_first_not_of("0123456789.") == std::string::npos; }
+}  // namespace
+
+const CLI::Validator kFrameIndex([](std::string& v) { return whole_number_at_least(v, 0); }, "INDEX");
+const CLI::Validator kFrameCount([](std::string& v) { return whole_number_at_least(v, 1); }, "COUNT");
+
+const CLI::Validator kListenAddress(
+    [](std::string& v) -> std::string {
+      in_addr a4{};
+      in6_addr a6{};
+      if (::inet_pton(AF_INET, v.c_str(), &a4) == 1 || ::inet_pton(AF_INET6, v.c_str(), &a6) == 1) return {};
+      const std::string hint = "; use an address of this machine, e.g. 127.0.0.1, 0.0.0.0 (all) or ::1";
+      if (looks_like_ipv4(v)) return "'" + v + "' is not an IPv4 address (four numbers from 0 to 255)" + hint;
+      addrinfo hints{};
+      hints.ai_flags = AI_PASSIVE;
+      hints.ai_socktype = SOCK_STREAM;
+      addrinfo* found = nullptr;
+      if (::getaddrinfo(v.c_str(), nullptr, &hints, &found) != 0)
+        return "'" + v + "' is neither an IP address nor a host name that resolves" + hint;
+      ::freeaddrinfo(found);
+      return {};
+    },
+    "ADDRESS");
+
+void check_first_frame(std::size_t first, std::size_t frames) {
+  if (first < frames) return;
+  throw InputError(fmt::format("--first {}: the dataset has {} frames, so --first is at most {}", first, frames,
+                               frames == 0 ? 0 : frames - 1));
 }
 
 CLI::Validator finite_range(double lo, double hi, bool lo_open) {

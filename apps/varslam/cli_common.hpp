@@ -15,6 +15,19 @@ namespace varslam::cli {
 /// `lo_open`); the error names the value and the range, and CLI11 names the option.
 CLI::Validator finite_range(double lo, double hi, bool lo_open = false);
 
+/// A path option's check: not empty ('' would mean the current folder or nothing, silently); CLI11 names the option.
+extern const CLI::Validator kNonEmptyPath;
+
+/// Frame indices (0 or more) and frame counts (1 or more): CLI11 would wrap "-1" around to the largest size_t.
+extern const CLI::Validator kFrameIndex;
+extern const CLI::Validator kFrameCount;
+
+/// An address to listen on: an IPv4 or IPv6 address, or a host name that resolves ("999.1.1.1" is neither).
+extern const CLI::Validator kListenAddress;
+
+/// InputError naming --first when it is not a frame of a dataset of `frames` frames.
+void check_first_frame(std::size_t first, std::size_t frames);
+
 /// Writes <run>/report.html (plots of the trajectory, error, alpha per keyframe, timings); a failure is a warning.
 void write_report_for_run(const std::filesystem::path& run_dir, const std::filesystem::path& sequence_dir);
 

@@ -8,6 +8,7 @@
 #include "commands.hpp"
 #include "core/error.hpp"
 #include "io/dataset.hpp"
+#include "io/file_problem.hpp"
 #include "io/settings_registry.hpp"
 
 namespace varslam::cli {
@@ -21,8 +22,10 @@ void add_bag_command(CLI::App& app) {
   };
   auto o = std::make_shared<Opts>();
   auto* cmd = app.add_subcommand("bag-from-folder", "Write a dataset folder as a ROS 1 bag (what a robot records)");
-  cmd->add_option("--dataset,-d", o->dataset, "Dataset folder (TUM/Bonn/OpenLORIS layout)")->required();
-  cmd->add_option("--out,-o", o->out, "The bag to write (.bag)")->required();
+  cmd->add_option("--dataset,-d", o->dataset, "Dataset folder (TUM/Bonn/OpenLORIS layout)")
+      ->required()
+      ->check(kNonEmptyPath);
+  cmd->add_option("--out,-o", o->out, "The bag to write (.bag)")->required()->check(kNonEmptyPath);
   cmd->add_option("--settings,-s", o->settings, "Settings YAML (default: <dataset>/settings.yaml): the CameraInfo");
   cmd->add_option("--layout", o->layout,
                   "Topic layout: tum (/camera/rgb/image_color, ...) or realsense "
@@ -34,8 +37,8 @@ void add_bag_command(CLI::App& app) {
                   "compressedDepth PNG) or jpeg (colour JPEG, lossy; depth compressedDepth PNG)")
       ->capture_default_str()
       ->check(CLI::IsMember({"raw", "png", "jpeg"}));
-  cmd->add_option("--first", o->first, "First frame index");
-  cmd->add_option("--max-frames,-n", o->max_frames, "Write at most this many frames");
+  cmd->add_option("--first", o->first, "First frame index")->check(kFrameIndex);
+  cmd->add_option("--max-frames,-n", o->max_frames, "Write at most this many frames")->check(kFrameCount);
   cmd->add_option("--time-offset", o->time_offset,
                   "Seconds added to every stamp (ground truth included): a bag cannot hold time 0, which datasets "
                   "with a clock from 0 (7-Scenes) start at")
@@ -51,6 +54,8 @@ void add_bag_command(CLI::App& app) {
     Settings settings = settings_for_dataset(o->dataset, sfile);
     apply_setting_overrides(settings, o->overrides);
     const auto dataset = open_dataset(o->dataset, settings);
+    check_first_frame(o->first, dataset->size());
+    check_output_file(o->out, "bag");
     bag::BagWriteOptions wo;
     wo.layout = o->layout == "tum" ? bag::BagLayout::Tum : bag::BagLayout::RealSense;
     wo.images = o->images == "raw"   ? bag::BagImages::Raw

@@ -63,9 +63,10 @@ void add_bench_command(CLI::App& app) {
       ->check(finite_range(0.0, 3600.0, true));
   cmd->add_option("--configs", o->configs, "Configurations: huber, semantic, kernel, full")->capture_default_str();
   cmd->add_option("--jobs,-j", o->b.jobs, "Parallel child processes (default: number of cores)");
-  cmd->add_option("--out,-o", o->b.out, "Output folder")->capture_default_str();
+  cmd->add_option("--out,-o", o->b.out, "Output folder")->capture_default_str()->check(kNonEmptyPath);
   cmd->add_option("--cache", o->b.cache_dir, "Folder of generated sequences, reusable across benchmarks "
-                                             "(default: <out>/sequences)");
+                                             "(default: <out>/sequences)")
+      ->check(kNonEmptyPath);
   cmd->add_flag("--fresh", o->fresh, "Regenerate sequences even when the cache has them");
   cmd->add_option("--real", o->real, "Real dataset folder (TUM/Bonn/OpenLORIS/7-Scenes layout), repeatable")
       ->check(CLI::ExistingDirectory);

@@ -20,7 +20,7 @@ void add_demo_command(CLI::App& app) {
   };
   auto o = std::make_shared<Opts>();
   auto* cmd = app.add_subcommand("demo", "Generate a short synthetic dynamic scene and run SLAM on it");
-  cmd->add_option("--out,-o", o->out, "Output folder")->capture_default_str();
+  cmd->add_option("--out,-o", o->out, "Output folder")->capture_default_str()->check(kNonEmptyPath);
   cmd->add_option("--scenario", o->scenario, "Synthetic scenario")->capture_default_str();
   cmd->add_option("--seconds", o->seconds, "Length of the scene")
       ->capture_default_str()

@@ -8,6 +8,8 @@
 #include "commands.hpp"
 #include "core/error.hpp"
 #include "eval/eval_report.hpp"
+#include "io/atomic_file.hpp"
+#include "io/file_problem.hpp"
 #include "io/frame_list.hpp"
 #include "io/trajectory_io.hpp"
 #include "mapfile/map_file.hpp"
@@ -31,6 +33,8 @@ struct EvalArgs {
 };
 
 void run_eval(const EvalArgs& a) {
+  if (!a.json.empty()) check_output_file(a.json, "JSON report");
+  if (!a.plot.empty()) check_output_file(a.plot, "plot");
   const Trajectory gt = read_tum_trajectory(a.gt);
   const Trajectory est = read_tum_trajectory(a.est);
   EvalOptions options;
@@ -67,9 +71,7 @@ void run_eval(const EvalArgs& a) {
   if (!a.json.empty()) {
     nlohmann::json j = eval_to_json(summary, a.per_pair);
     j["files"] = {{"gt", a.gt}, {"est", a.est}};
-    std::ofstream out(a.json);
-    out << j.dump(2) << '\n';
-    if (!out) throw InputError(a.json + ": cannot write the JSON report");
+    write_file_atomically(a.json, j.dump(2) + "\n", "JSON report");
     std::printf("wrote %s\n", a.json.c_str());
   }
   if (!a.plot.empty()) {
@@ -84,9 +86,10 @@ void add_eval_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("eval", "ATE (TUM evaluate_ate), RPE per second and correct rate of a trajectory");
   cmd->add_option("--gt", args->gt, "Ground-truth trajectory (TUM format)")->required()->check(CLI::ExistingFile);
   cmd->add_option("--est", args->est, "Estimated trajectory (TUM format)")->required()->check(CLI::ExistingFile);
-  cmd->add_option("--json", args->json, "Write every figure as JSON here");
+  cmd->add_option("--json", args->json, "Write every figure as JSON here")->check(kNonEmptyPath);
   cmd->add_option("--plot", args->plot,
-                  "Write the top view here (.svg or .png) and the error over time as <stem>_ate_error.<ext>");
+                  "Write the top view here (.svg or .png) and the error over time as <stem>_ate_error.<ext>")
+      ->check(kNonEmptyPath);
   cmd->add_option("--max-diff", args->max_diff, "Association window in seconds (strict)")
       ->capture_default_str()
       ->check(finite_range(0.0, 1e6, true));

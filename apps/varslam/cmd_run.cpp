@@ -17,15 +17,6 @@
 namespace varslam::cli {
 namespace {
 
-// Frame counts and indices: CLI11 would wrap "-1" around to the largest size_t ("all frames").
-const CLI::Validator kCount(
-    [](std::string& v) {
-      return v.find_first_not_of("0123456789") == std::string::npos && !v.empty()
-                 ? std::string()
-                 : "expected a whole number of frames, 0 or more, got '" + v + "'";
-    },
-    "COUNT");
-
 template <typename Opts>
 std::unique_ptr<viewer::LiveViewer> start_viewer(const Opts& o, const Dataset& dataset, const run::RunOptions& ro) {
   viewer::LiveViewerOptions vo;
@@ -68,7 +59,8 @@ void add_run_command(CLI::App& app) {
   auto o = std::make_shared<Opts>();
   auto* cmd = app.add_subcommand("run", "Run SLAM on a dataset folder and write trajectory, map and metrics");
   cmd->add_option("--dataset,-d", o->dataset, "Dataset folder (TUM/Bonn/OpenLORIS layout) or a ROS 1 .bag file")
-      ->required();
+      ->required()
+      ->check(kNonEmptyPath);
   cmd->add_option("--topic-rgb", o->topics.rgb, "Bag input: the colour image topic (default: found by type and name)");
   cmd->add_option("--topic-depth", o->topics.depth, "Bag input: the depth image topic (default: found by type and name)");
   cmd->add_option("--topic-info", o->topics.info,
@@ -76,18 +68,21 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("--gt-frame", o->topics.gt_frame,
                   "Bag input: ground truth is the /tf pose of this child frame (e.g. /kinect in TUM bags)");
   cmd->add_option("--settings,-s", o->settings, "Settings YAML (default: <dataset>/settings.yaml)");
-  cmd->add_option("--out,-o", o->out, "Output folder")->capture_default_str();
-  cmd->add_option("--groundtruth", o->groundtruth, "Ground truth TUM file (default: <dataset>/groundtruth.txt)");
+  cmd->add_option("--out,-o", o->out, "Output folder")->capture_default_str()->check(kNonEmptyPath);
+  cmd->add_option("--groundtruth", o->groundtruth, "Ground truth TUM file (default: <dataset>/groundtruth.txt)")
+      ->check(kNonEmptyPath);
   cmd->add_flag("--realtime", o->realtime, "Real-time mode: local mapping on its own thread");
   cmd->add_flag("--pace", o->pace, "With --realtime: feed frames at the dataset's frame rate");
-  cmd->add_option("--first", o->first, "First frame index")->check(kCount);
-  cmd->add_option("--max-frames,-n", o->max_frames, "Process at most this many frames")->check(kCount);
+  cmd->add_option("--first", o->first, "First frame index")->check(kFrameIndex);
+  cmd->add_option("--max-frames,-n", o->max_frames, "Process at most this many frames")->check(kFrameCount);
   cmd->add_option("--min-tracked-share", o->min_tracked_share,
                   "A run tracking a smaller share of its frames fails (exit 4); 0 accepts any run")
       ->capture_default_str()
       ->check(finite_range(0.0, 1.0));
-  cmd->add_option("--save-map", o->save_map, "Write the final map here (docs/map_format.md)");
-  cmd->add_option("--load-map", o->load_map, "Start from this saved map: the first frames relocalize in it");
+  cmd->add_option("--save-map", o->save_map, "Write the final map here (docs/map_format.md)")
+      ->check(kNonEmptyPath);
+  cmd->add_option("--load-map", o->load_map, "Start from this saved map: the first frames relocalize in it")
+      ->check(kNonEmptyPath);
   cmd->add_flag("--localization-only", o->localization_only,
                 "With --load-map: track in the loaded map without extending it (no keyframes, no points)");
   cmd->add_flag("--viewer", o->viewer, "Watch the run live in a browser (the address is printed on start)");
@@ -96,7 +91,8 @@ void add_run_command(CLI::App& app) {
       ->check(CLI::Range(0, 65535));
   cmd->add_option("--viewer-address", o->viewer_address,
                   "Listen on this address instead of loopback (reachable from the network: use with care)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(kListenAddress);
   cmd->add_option("--viewer-fps", o->viewer_fps,
                   "Frames per second sent to the browser at most (lower it when the browser shares a small machine)")
       ->capture_default_str()
@@ -120,6 +116,7 @@ void add_run_command(CLI::App& app) {
     Settings settings = bag ? bag::settings_for_bag(o->dataset, sfile, t) : settings_for_dataset(o->dataset, sfile);
     apply_setting_overrides(settings, o->overrides);
     auto dataset = bag ? bag::open_bag_dataset(o->dataset, settings, t) : open_dataset(o->dataset, settings);
+    check_first_frame(o->first, dataset->size());
     run::RunOptions ro;
     ro.mode = o->realtime ? RunMode::RealTime : RunMode::Deterministic;
     ro.pace = o->pace;
@@ -159,6 +156,8 @@ void add_run_command(CLI::App& app) {
       spdlog::info("viewer: the run is over; {} keeps showing it until Ctrl+C", live_viewer->url());
       wait_for_stop();
     }
+    if (s.map_error) throw InputError(fmt::format("--save-map: {}; the other outputs are in {}", *s.map_error,
+                                                  s.out_dir.string()));
     if (s.interrupted)
       throw CommandFailed(fmt::format("interrupted after {} frames; what was tracked is in {}", s.frames,
                                       s.out_dir.string()),

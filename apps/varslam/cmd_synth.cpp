@@ -32,7 +32,7 @@ void add_synth_command(CLI::App& app) {
   cmd->add_option("--path-start", opt->cfg.path_start, "Seconds into the path where the sequence starts")
       ->check(finite_range(0.0, 1e6))
       ->capture_default_str();
-  cmd->add_option("--out", opt->out, "Output folder (default: synth_<scenario>_<seed>)");
+  cmd->add_option("--out", opt->out, "Output folder (default: synth_<scenario>_<seed>)")->check(kNonEmptyPath);
   cmd->add_flag("--no-preview", opt->no_preview, "Do not write preview.png");
   cmd->add_flag("--hide-movers", opt->hide_movers,
                 "Debug: render the scenario's world without its movers (identical to 'static')");

@@ -51,7 +51,9 @@ void add_view_command(CLI::App& app) {
   cmd->add_option("--map", o->map, "A map saved by the run (--save-map): keyframes, graph and points");
   cmd->add_option("--dataset,-d", o->dataset, "The run's dataset, for its images (default: the one in metrics.json)");
   cmd->add_option("--port", o->port, "Port (0: a free one)")->capture_default_str()->check(CLI::Range(0, 65535));
-  cmd->add_option("--address", o->address, "Listen on this address instead of loopback")->capture_default_str();
+  cmd->add_option("--address", o->address, "Listen on this address instead of loopback")
+      ->capture_default_str()
+      ->check(kListenAddress);
   cmd->callback([o] {
     const std::unique_ptr<Dataset> dataset = dataset_of_run(o->run, o->dataset);
     std::optional<std::filesystem::path> map_file;

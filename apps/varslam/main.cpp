@@ -3,9 +3,11 @@
 #include <spdlog/spdlog.h>
 
 #include <exception>
+#include <filesystem>
 
 #include "commands.hpp"
 #include "core/error.hpp"
+#include "io/file_problem.hpp"
 
 int main(int argc, char** argv) {
   // Logs and errors go to stderr; stdout carries what a command prints (summaries, `settings`, `eval`).
@@ -36,6 +38,10 @@ int main(int argc, char** argv) {
     return e.code;
   } catch (const varslam::InputError& e) {
     spdlog::error("{}", e.what());
+    return varslam::cli::kExitInputError;
+  } catch (const std::filesystem::filesystem_error& e) {
+    // A path the system refused (permission, a symlink loop, a full disk): the path's problem, not a bug.
+    spdlog::error("{}", varslam::describe_filesystem_error(e));
     return varslam::cli::kExitInputError;
   } catch (const std::exception& e) {
     spdlog::error("internal error: {}", e.what());

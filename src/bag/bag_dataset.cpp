@@ -173,6 +173,16 @@ class BagDataset final : public Dataset {
   std::optional<fs::path> groundtruth_;
 };
 
+// Two /tf poses of the ground-truth frame at one stamp: the same measurement twice, or ambiguous ground truth.
+void check_same_pose_at_stamp(const bagfile::Reader& reader, const std::string& frame, const StampedPose& first,
+                              const StampedPose& again) {
+  const PoseGap gap = pose_gap(first, again);
+  if (is_same_measurement(gap)) return;
+  throw InputError(fmt::format("{}: --gt-frame {}: two poses at stamp {:.6f}, {:.3f} m and {:.2f} deg apart; the "
+                               "ground truth is ambiguous there",
+                               reader.file(), frame, again.timestamp, gap.metres, gap.degrees));
+}
+
 // Poses of the ground-truth frame from /tf as a TUM file in a folder of its own (removed with the dataset).
 fs::path extract_groundtruth(const bagfile::Reader& reader, const std::string& frame) {
   const auto tfs = reader.transforms(frame);
@@ -184,6 +194,7 @@ fs::path extract_groundtruth(const bagfile::Reader& reader, const std::string& f
     StampedPose p;
     p.timestamp = t.stamp;
     p.T_wc = Eigen::Translation3d(t.tx, t.ty, t.tz) * Eigen::Quaterniond(t.qw, t.qx, t.qy, t.qz).normalized();
+    if (!gt.empty() && p.timestamp == gt.back().timestamp) check_same_pose_at_stamp(reader, frame, gt.back(), p);
     if (gt.empty() || p.timestamp > gt.back().timestamp) gt.push_back(p);
   }
   std::string tmpl = (fs::temp_directory_path() / "varslam-bag-gt-XXXXXX").string();

@@ -3,11 +3,13 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <cerrno>
 #include <cmath>
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/error.hpp"
 #include "io/boxes_io.hpp"
+#include "io/file_problem.hpp"
 #include "io/trajectory_io.hpp"
 
 #ifdef VARSLAM_HAVE_ROSBAG
@@ -93,11 +95,13 @@ BagWriteSummary write_bag_from_dataset(const Dataset& dataset, const Settings& s
                     "ground truth included)",
                     dataset.root().string(), dataset.timestamp(first),
                     options.time_offset != 0 ? fmt::format(" (with offset {})", options.time_offset) : std::string()));
+  // Read before the frames are written, so a broken file fails at once.
+  const Trajectory groundtruth = dataset.groundtruth() ? read_tum_trajectory(*dataset.groundtruth()) : Trajectory{};
   if (out.has_parent_path()) fs::create_directories(out.parent_path());
   const fs::path tmp = out.string() + ".partial";
   BagWriteSummary summary;
   summary.info_topic = t.rgb_info;
-  {
+  try {
     bagfile::Writer w(tmp.string());
     const double dt = options.time_offset;
     const double t0 = dataset.timestamp(first) + dt;
@@ -146,19 +150,28 @@ BagWriteSummary write_bag_from_dataset(const Dataset& dataset, const Settings& s
       ++summary.frames;
       if (options.progress) options.progress(summary.frames, end - first);
     }
-    if (const auto gt_file = dataset.groundtruth()) {
-      for (const StampedPose& p : read_tum_trajectory(*gt_file)) {
-        if (p.timestamp < dataset.timestamp(first) - 1.0 || p.timestamp > dataset.timestamp(end - 1) + 1.0) continue;
-        const Eigen::Quaterniond q(p.T_wc.rotation());
-        const Eigen::Vector3d x = p.T_wc.translation();
-        if (p.timestamp + dt < 1e-6) continue;
-        w.transform("/tf", {p.timestamp + dt, "world", "kinect", x.x(), x.y(), x.z(), q.x(), q.y(), q.z(), q.w()});
-        ++summary.groundtruth_poses;
-      }
+    for (const StampedPose& p : groundtruth) {
+      if (p.timestamp < dataset.timestamp(first) - 1.0 || p.timestamp > dataset.timestamp(end - 1) + 1.0) continue;
+      const Eigen::Quaterniond q(p.T_wc.rotation());
+      const Eigen::Vector3d x = p.T_wc.translation();
+      if (p.timestamp + dt < 1e-6) continue;
+      w.transform("/tf", {p.timestamp + dt, "world", "kinect", x.x(), x.y(), x.z(), q.x(), q.y(), q.z(), q.w()});
+      ++summary.groundtruth_poses;
     }
     summary.rgb_topic = rgb_topic;
     summary.depth_topic = depth_topic;
     w.close();
+  } catch (const InputError&) {
+    std::error_code ec;
+    fs::remove(tmp, ec);
+    throw;
+  } catch (const std::exception& e) {
+    // The bag library's own words lack the reason; the failed write's errno has it (a full disk, a quota).
+    const int err = errno;
+    std::error_code ec;
+    fs::remove(tmp, ec);
+    const bool known = err == ENOSPC || err == EDQUOT || err == EROFS || err == EACCES || err == EIO;
+    throw InputError(fmt::format("{}: cannot write the bag: {}", out.string(), known ? describe_errno(err) : e.what()));
   }
   fs::rename(tmp, out);
   spdlog::info("{}: {} frames ({}, {}), {} ground-truth poses as /tf world -> kinect", out.string(), summary.frames,

@@ -5,6 +5,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.hpp"
+#include "io/atomic_file.hpp"
 #include "eval/plot_layout.hpp"
 
 namespace varslam {
@@ -74,13 +75,7 @@ cv::Mat render_plot_image(const Plot& plot) {
 }
 
 void write_plot_png(const Plot& plot, const std::filesystem::path& file) {
-  bool ok = false;
-  try {
-    ok = cv::imwrite(file.string(), render_plot_image(plot));
-  } catch (const cv::Exception& e) {
-    throw InputError(file.string() + ": cannot write the plot (" + e.what() + ")");
-  }
-  if (!ok) throw InputError(file.string() + ": cannot write the plot");
+  write_image_atomically(file, render_plot_image(plot), "plot");
 }
 
 }  // namespace varslam

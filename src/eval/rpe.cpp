@@ -1,5 +1,7 @@
 #include "eval/rpe.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -47,6 +49,10 @@ RpeResult evaluate_rpe(const Trajectory& gt_in, const Trajectory& est_in, const 
   }
   const auto gt_stamps = stamps_of(gt);
   const auto est_stamps = stamps_of(est);
+  // No pose has a partner delta later: say so, rather than suggest files of different sequences.
+  if (const double span = est_stamps.back() - est_stamps.front(); span < options.delta_seconds)
+    throw InputError(fmt::format("RPE: the run is too short for RPE at a delta of {:g} s: its poses span {:.2f} s",
+                                 options.delta_seconds, span));
   const double max_gt_gap = 2.0 * median_interval(gt_stamps);
 
   RpeResult r;

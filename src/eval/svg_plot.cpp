@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "core/error.hpp"
+#include "io/atomic_file.hpp"
 #include "eval/plot_image.hpp"
 #include "eval/plot_layout.hpp"
 
@@ -133,9 +134,7 @@ void write_plot(const Plot& plot, const std::filesystem::path& file) {
   if (ext != ".svg") {
     throw InputError(file.string() + ": unknown plot format '" + ext + "' (use .svg or .png)");
   }
-  std::ofstream out(file, std::ios::binary);
-  out << render_svg(plot);
-  if (!out) throw InputError(file.string() + ": cannot write the plot");
+  write_file_atomically(file, render_svg(plot), "plot");
 }
 
 }  // namespace varslam

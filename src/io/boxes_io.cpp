@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "io/atomic_file.hpp"
 #include "io/text_lines.hpp"
 
 namespace varslam {
@@ -41,13 +42,12 @@ BoxesByTime read_boxes_file(const std::filesystem::path& file) {
 }
 
 void write_boxes_file(const BoxesByTime& boxes, const std::filesystem::path& file) {
-  std::ofstream out(file);
-  if (!out) throw InputError(fmt::format("{}: cannot write boxes file", file.string()));
-  out << "# timestamp label score x y w h (pixels)\n";
+  std::string text = "# timestamp label score x y w h (pixels)\n";
   for (const auto& [t, dets] : boxes)
     for (const auto& d : dets)
-      out << fmt::format("{:.6f} {} {:.3f} {:.1f} {:.1f} {:.1f} {:.1f}\n", t, d.label, d.score, d.box.x, d.box.y,
-                         d.box.width, d.box.height);
+      text += fmt::format("{:.6f} {} {:.3f} {:.1f} {:.1f} {:.1f} {:.1f}\n", t, d.label, d.score, d.box.x, d.box.y,
+                          d.box.width, d.box.height);
+  write_file_atomically(file, text, "boxes file");
 }
 
 Detections boxes_near(const BoxesByTime& boxes, double t, double max_dt) {

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <atomic>
+#include <cerrno>
 #include <cstring>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
@@ -15,6 +16,7 @@
 
 #include "core/error.hpp"
 #include "io/depth_image.hpp"
+#include "io/file_problem.hpp"
 #include "io/frame_list.hpp"
 
 namespace varslam {
@@ -92,20 +94,34 @@ class ListedRgbdDataset final : public Dataset {
     return out;
   }
 
-  // Listed files that are not on disk (counted once at open, so a broken copy is reported early).
-  std::size_t count_missing(std::string* first_missing) const {
-    std::size_t n = 0;
+  struct ListedFileProblems {
+    std::size_t missing = 0, unreadable = 0;
+    std::string first_missing, first_unreadable;
+  };
+
+  // Listed files that are not on disk or cannot be reached (a symlink loop, a folder without permission): counted
+  // once at open, so a broken copy is reported early; the run skips those frames.
+  ListedFileProblems check_listed_files() const {
+    ListedFileProblems p;
     for (const auto& f : frames_)
-      for (const ListEntry* e : {&f.rgb, &f.depth})
-        if (!fs::exists(root_ / e->path)) {
-          if (n++ == 0 && first_missing) *first_missing = fmt::format("{} ({})", (root_ / e->path).string(), e->where);
-        }
-    return n;
+      for (const ListEntry* e : {&f.rgb, &f.depth}) {
+        std::error_code ec;
+        const fs::path file = root_ / e->path;
+        if (fs::exists(file, ec)) continue;
+        if (ec && p.unreadable++ == 0)
+          p.first_unreadable = fmt::format("{} ({}): {}", file.string(), e->where, describe_error(ec));
+        if (!ec && p.missing++ == 0) p.first_missing = fmt::format("{} ({})", file.string(), e->where);
+      }
+    return p;
   }
 
  private:
+  // A loop of symbolic links or a folder without permission is an unreadable frame like a missing one.
   static void check_exists(const ListEntry& e, const std::string& path) {
-    if (!fs::exists(path)) throw InputError(fmt::format("{}: listed image {} does not exist", e.where, path));
+    std::error_code ec;
+    const bool exists = fs::exists(path, ec);
+    if (ec) throw InputError(fmt::format("{}: cannot read image {}: {}", e.where, path, describe_error(ec)));
+    if (!exists) throw InputError(fmt::format("{}: listed image {} does not exist", e.where, path));
   }
 
   // OpenCV picks a decoder by the file's content, whatever its name, and some it links abort on malformed input
@@ -113,6 +129,7 @@ class ListedRgbdDataset final : public Dataset {
   static void check_image_format(const ListEntry& e, const std::string& path) {
     std::array<unsigned char, 132> head{};
     std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(fmt::format("{}: cannot read image {}: {}", e.where, path, describe_errno(errno)));
     in.read(reinterpret_cast<char*>(head.data()), head.size());
     const auto n = static_cast<std::size_t>(in.gcount());
     const bool png = n >= 8 && std::memcmp(head.data(), "\x89PNG\r\n\x1a\n", 8) == 0;
@@ -177,9 +194,12 @@ std::unique_ptr<Dataset> open_dataset(const std::filesystem::path& dir, const Se
   if (!fs::is_directory(dir)) throw InputError(fmt::format("{}: not a folder", dir.string()));
   const LayoutFiles& layout = detect_layout(dir);
   auto ds = std::make_unique<ListedRgbdDataset>(dir, layout.name, read_frames(dir, layout), settings);
-  std::string first_missing;
-  if (const std::size_t missing = ds->count_missing(&first_missing); missing > 0)
-    spdlog::warn("{}: {} listed images are missing, first {}", dir.string(), missing, first_missing);
+  const auto problems = ds->check_listed_files();
+  if (problems.missing > 0)
+    spdlog::warn("{}: {} listed images are missing, first {}", dir.string(), problems.missing, problems.first_missing);
+  if (problems.unreadable > 0)
+    spdlog::warn("{}: {} listed images cannot be read, first {}", dir.string(), problems.unreadable,
+                 problems.first_unreadable);
   spdlog::info("{}: {} layout, {} frames{}", dir.string(), layout.name, ds->size(),
                ds->groundtruth() ? ", with ground truth" : "");
   return ds;

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "io/atomic_file.hpp"
 #include "io/settings_registry.hpp"
 
 namespace varslam {
@@ -178,11 +179,7 @@ std::string settings_yaml(const Settings& s) {
 }
 
 void save_settings(const Settings& s, const std::filesystem::path& file) {
-  const std::string text = settings_yaml(s);
-  std::ofstream out(file);
-  if (!out) throw ConfigError(fmt::format("{}: cannot write settings file", file.string()));
-  out << text;
-  if (!out) throw ConfigError(fmt::format("{}: error while writing settings file", file.string()));
+  write_file_atomically(file, settings_yaml(s), "settings file");
 }
 
 }  // namespace varslam

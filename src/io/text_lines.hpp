@@ -19,8 +19,8 @@ struct TextLine {
   std::string where;                // "file:line" for error messages
 };
 
-/// Calls fn for every line that is neither blank nor a '#' comment. Throws InputError "<file>: cannot open
-/// <what>" when the file cannot be read.
+/// Calls fn for every line that is neither blank nor a '#' comment (a UTF-8 byte-order mark before the first line is
+/// dropped). Throws InputError "<file>: cannot open <what>: <why>" when the file cannot be read.
 void for_each_data_line(const std::filesystem::path& file, const std::string& what,
                         const std::function<void(const TextLine&)>& fn);
 

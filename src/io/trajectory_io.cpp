@@ -4,9 +4,11 @@
 #include <spdlog/spdlog.h>
 
 #include <array>
+#include <Eigen/Geometry>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <numbers>
 #include <sstream>
 #include <string>
 
@@ -18,7 +20,31 @@ namespace varslam {
 namespace {
 // Beyond this a coordinate is garbage (and squared in the ATE it would overflow), whatever the unit.
 constexpr double kMaxCoordinate = 1e6;
+// A repeated timestamp within these of the pose before it is the same measurement sent twice (real TUM ground
+// truth has a few, 1 mm apart); farther, one of the two lines is wrong and an ATE against it would be too.
+constexpr double kSameMeasurementM = 0.01;
+constexpr double kSameMeasurementDeg = 1.0;
+
+// Refuses a repeated timestamp whose pose is not the one before it, naming both lines.
+void check_repeat_is_same_pose(const std::filesystem::path& file, const StampedPose& before, int before_line,
+                               const StampedPose& again, int again_line) {
+  const PoseGap gap = pose_gap(before, again);
+  if (is_same_measurement(gap)) return;
+  throw InputError(fmt::format("{}:{}: timestamp {:.6f} is also on line {} with another pose ({:.3f} m and {:.2f} deg "
+                               "away); a timestamp may repeat only its pose: remove the wrong one of lines {} and {}",
+                               file.string(), again_line, again.timestamp, before_line, gap.metres, gap.degrees,
+                               before_line, again_line));
+}
 }  // namespace
+
+PoseGap pose_gap(const StampedPose& a, const StampedPose& b) {
+  return {(b.T_wc.translation() - a.T_wc.translation()).norm(),
+          Eigen::AngleAxisd(a.T_wc.linear().transpose() * b.T_wc.linear()).angle() * 180.0 / std::numbers::pi};
+}
+
+bool is_same_measurement(const PoseGap& gap) {
+  return gap.metres <= kSameMeasurementM && gap.degrees <= kSameMeasurementDeg;
+}
 
 Trajectory read_tum_trajectory(const std::filesystem::path& file) {
   Trajectory out;
@@ -54,9 +80,10 @@ Trajectory read_tum_trajectory(const std::filesystem::path& file) {
     p.timestamp = v[0];
     p.T_wc.linear() = q.toRotationMatrix();
     p.T_wc.translation() = Eigen::Vector3d(v[1], v[2], v[3]);
-    // Real TUM ground truth repeats a timestamp now and then; like the TUM tools (a dict keyed by time),
-    // the later line wins.
+    // Real TUM ground truth repeats a timestamp now and then, with the same pose to a millimetre; like the TUM
+    // tools (a dict keyed by time), the later line wins.
     if (!out.empty() && v[0] == out.back().timestamp) {
+      check_repeat_is_same_pose(file, out.back(), prev_line, p, line_no);
       out.back() = p;
       ++duplicates;
     } else {
@@ -65,7 +92,8 @@ Trajectory read_tum_trajectory(const std::filesystem::path& file) {
     prev_line = line_no;
   });
   if (duplicates > 0)
-    spdlog::debug("{}: {} repeated timestamps, kept the later pose of each", file.string(), duplicates);
+    spdlog::debug("{}: {} repeated timestamps with the same pose (within 1 cm and 1 deg), kept the later pose of each",
+                  file.string(), duplicates);
   return out;
 }
 

@@ -11,6 +11,7 @@
 #include <tuple>
 
 #include "core/error.hpp"
+#include "io/atomic_file.hpp"
 #include "report/html.hpp"
 #include "report/run_report.hpp"
 
@@ -333,9 +334,7 @@ void update_benchmarks_md(const std::filesystem::path& file, const std::string& 
   std::stringstream buf;
   buf << in.rdbuf();
   const std::string updated = replace_between_markers(buf.str(), generated, file.string());
-  std::ofstream out(file);
-  out << updated;
-  if (!out) throw InputError(file.string() + ": cannot write");
+  write_file_atomically(file, updated, "Markdown file");
 }
 
 nlohmann::json to_json(const RunRecord& r) {

@@ -10,6 +10,8 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "io/atomic_file.hpp"
+#include "io/output_folder.hpp"
 #include "eval/ate.hpp"
 #include "eval/drag_events.hpp"
 #include "io/trajectory_io.hpp"
@@ -33,11 +35,7 @@ std::string read_text(const fs::path& file) {
   return s.str();
 }
 
-void write_text(const fs::path& file, const std::string& text) {
-  std::ofstream out(file);
-  out << text;
-  if (!out) throw InputError(file.string() + ": cannot write");
-}
+void write_text(const fs::path& file, const std::string& text) { write_file_atomically(file, text, "benchmark file"); }
 
 std::string now_iso8601() {
   const std::time_t t = std::time(nullptr);
@@ -121,7 +119,10 @@ BenchOutcome run_benchmark(const BenchOptions& o) {
     throw InputError("bench: --detector must be auto, boxes or yolo, got '" + o.detector + "'");
   const fs::path out = fs::absolute(o.out).lexically_normal();
   const fs::path cache = o.cache_dir.empty() ? out / "sequences" : fs::absolute(o.cache_dir).lexically_normal();
-  fs::create_directories(out);
+  // The summary files are the benchmark's own; each run folder is its run's (varslam run keeps its manifest).
+  const OutputFolder out_folder(out, {{"results.json", "benchmark results"},
+                                      {"table.md", "benchmark table"},
+                                      {"index.html", "benchmark summary"}});
   fs::create_directories(cache);
   const fs::path exe = o.executable.empty() ? self_executable() : fs::absolute(o.executable);
 
@@ -184,8 +185,9 @@ BenchOutcome run_benchmark(const BenchOptions& o) {
         argv.emplace_back("--set");
         argv.push_back(s);
       }
-      // A stale metrics.json from an earlier benchmark must not pass for this run's result.
-      fs::remove(run_dir / "metrics.json");
+      // A stale metrics.json from an earlier benchmark must not pass for this run's result (a run that fails
+      // before it starts leaves the earlier one's files otherwise).
+      remove_earlier_outputs(run_dir);
       tasks.push_back({argv, run_dir / "run.log", after, o.timeout_seconds});
       plan.push_back({Planned::Kind::Run, si, config_name, detector, run_dir, shell_join(argv)});
     }
@@ -341,7 +343,7 @@ BenchOutcome run_benchmark(const BenchOptions& o) {
       {"failed_runs", result.failed},
       {"table_markdown", result.table_markdown}};
 
-  std::ofstream(out / "results.json") << result.results.dump(1) << '\n';
+  write_text(out / "results.json", result.results.dump(1) + "\n");
   const std::string header =
       fmt::format("Benchmark {} ({}), {} runs ({} failed) in {:.0f} s on {}; load average {:.1f} at the start.\n\n",
                   version, started, result.runs, result.failed, result.wall_seconds, describe(machine_start),

@@ -1,5 +1,7 @@
 #include "report/run_report.hpp"
 
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -42,6 +44,7 @@ Trajectory read_optional_trajectory(const std::filesystem::path& file, std::stri
     return read_tum_trajectory(file);
   } catch (const InputError& e) {
     problems += std::string(e.what()) + "\n";
+    spdlog::warn("report: drawn without {}: {}", file.filename().string(), e.what());
     return {};
   }
 }

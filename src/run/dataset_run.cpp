@@ -3,10 +3,6 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
-#include <fcntl.h>
-#include <sys/file.h>
-#include <unistd.h>
-
 #include <chrono>
 #include <fstream>
 #include <thread>
@@ -16,6 +12,8 @@
 #include "eval/drag_events.hpp"
 #include "eval/rpe.hpp"
 #include "io/atomic_file.hpp"
+#include "io/file_problem.hpp"
+#include "io/output_folder.hpp"
 #include "io/trajectory_io.hpp"
 #include "run/filter_stage_writer.hpp"
 #include "run/metrics_recorder.hpp"
@@ -125,45 +123,19 @@ std::string likely_cause(const MetricsRecorder& metrics, const Settings& setting
   return "keypoints and depth look usable: fast motion, a wrong camera model, or a scene dominated by movers";
 }
 
-// The run's folder: created, cleared of an earlier run's outputs, and held against a concurrent run.
-class OutputFolder {
- public:
-  explicit OutputFolder(const std::filesystem::path& dir) {
-    std::error_code ec;
-    std::filesystem::create_directories(dir, ec);
-    if (ec || !std::filesystem::is_directory(dir))
-      throw InputError(fmt::format("{}: cannot create the output folder: {}", dir.string(),
-                                   ec ? ec.message() : std::string("a file of that name exists")));
-    const std::filesystem::path lock = dir / ".varslam.lock";
-    fd_ = ::open(lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-    if (fd_ < 0) throw InputError(fmt::format("{}: cannot write into the output folder", dir.string()));
-    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
-      ::close(fd_);
-      throw InputError(fmt::format("{}: another varslam run is writing into this folder; give this one another --out",
-                                   dir.string()));
-    }
-    // An earlier run's files would sit beside this run's and read as its results.
-    int removed = 0;
-    for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
-      const std::string name = e.path().filename().string();
-      const bool ours = name == "CameraTrajectory.txt" || name == "CameraTrajectory_aligned.txt" ||
-                        name == "KeyFrameTrajectory.txt" || name == "LiveTrajectory.txt" || name == "map.ply" ||
-                        name == "metrics.json" || name == "report.html" || name.rfind("semantic_stages_", 0) == 0;
-      // Files only: a folder of that name is the user's, and writing the output there fails with its name.
-      if (ours && e.is_regular_file(ec) && std::filesystem::remove(e.path(), ec)) ++removed;
-    }
-    if (removed > 0) spdlog::info("{}: removed {} files of an earlier run", dir.string(), removed);
-  }
-  ~OutputFolder() {
-    ::flock(fd_, LOCK_UN);
-    ::close(fd_);
-  }
-  OutputFolder(const OutputFolder&) = delete;
-  OutputFolder& operator=(const OutputFolder&) = delete;
-
- private:
-  int fd_ = -1;
-};
+// Every file a run may write into its folder (the report is written beside it by the CLI).
+std::vector<OutputFile> run_outputs(const RunOptions& options) {
+  std::vector<OutputFile> out = {{"CameraTrajectory.txt", "trajectory file"},
+                                 {"CameraTrajectory_aligned.txt", "trajectory file"},
+                                 {"KeyFrameTrajectory.txt", "trajectory file"},
+                                 {"LiveTrajectory.txt", "trajectory file"},
+                                 {"map.ply", "map"},
+                                 {"metrics.json", "metrics file"},
+                                 {"report.html", "report"}};
+  for (const std::size_t f : options.debug_frames)
+    out.push_back({FilterStageWriter::file_name(f), "filter stages image"});
+  return out;
+}
 
 }  // namespace
 
@@ -190,7 +162,8 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const RunO
     throw InputError(fmt::format("{}: ground truth file not found", options.groundtruth->string()));
   if (gt_path && std::filesystem::exists(*gt_path)) groundtruth = read_tum_trajectory(*gt_path);
 
-  const OutputFolder out(out_dir);
+  const OutputFolder out(out_dir, run_outputs(options));
+  if (options.save_map) check_output_file(*options.save_map, "map");  // after the folder: the map may go into it
   Pipeline slam(settings, PipelineOptions{options.mode, nullptr});
   MetricsRecorder metrics;
   slam.add_observer(metrics);
@@ -289,10 +262,18 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const RunO
     // A map built on a loaded one keeps the loaded map's frame, and so its alignment.
     const auto map_alignment = slam.loaded_map_alignment() ? slam.loaded_map_alignment() : alignment;
     const auto t0 = Clock::now();
-    slam.save_map(*options.save_map, map_alignment);
-    m["map_file"] = {{"path", options.save_map->string()},
-                     {"bytes", std::filesystem::file_size(*options.save_map)},
-                     {"save_ms", std::chrono::duration<double, std::milli>(Clock::now() - t0).count()}};
+    try {
+      slam.save_map(*options.save_map, map_alignment);
+      std::error_code ec;  // a device (/dev/null) has no size
+      const auto bytes = std::filesystem::file_size(*options.save_map, ec);
+      m["map_file"] = {{"path", options.save_map->string()},
+                       {"bytes", ec ? 0 : bytes},
+                       {"save_ms", std::chrono::duration<double, std::milli>(Clock::now() - t0).count()}};
+    } catch (const InputError& e) {
+      // The run's results are still worth having: metrics and report are written, then the command fails.
+      sum.map_error = e.what();
+      m["map_file"] = {{"path", options.save_map->string()}, {"error", e.what()}};
+    }
   }
   write_file_atomically(out_dir / "metrics.json", m.dump(2) + "\n", "metrics file");
   return sum;

@@ -44,13 +44,15 @@ struct RunSummary {
   std::string ate_note;          // why there is no ATE although ground truth exists
   std::optional<std::string> failure;  // the run tracked too little: the share and the likely cause
   bool interrupted = false;      // stopped through RunOptions::stop; the outputs hold what was tracked
+  std::optional<std::string> map_error;  // RunOptions::save_map could not be written (checked before the run too)
   nlohmann::json metrics;
   std::filesystem::path out_dir;
 };
 
 /// Runs SLAM with `settings` (the `semantic:` section decides whether a detector filters known movers; in
 /// deterministic mode detection is waited for, so results do not depend on timing). Ground truth is read before
-/// the run (a broken file fails at once); outputs of an earlier run in `out_dir` are removed first, every output
+/// the run (a broken file fails at once); outputs of an earlier run in `out_dir` (those its .varslam-outputs lists)
+/// are removed first, a folder holding files of the user's under the run's output names is refused, every output
 /// is written atomically, and a second run into the same folder at the same time is refused (InputError).
 RunSummary run_slam(const Dataset& dataset, const Settings& settings, const RunOptions& options,
                     const std::filesystem::path& out_dir);

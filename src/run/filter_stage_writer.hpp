@@ -3,6 +3,7 @@
 // keypoints | keypoints in boxes | keypoints kept after the depth test, the paper's Fig. 3) into a PNG.
 #include <filesystem>
 #include <set>
+#include <string>
 
 #include "pipeline/events.hpp"
 
@@ -14,6 +15,8 @@ class FilterStageWriter final : public Observer {
   FilterStageWriter(std::set<std::size_t> frames, std::filesystem::path out_dir)
       : frames_(std::move(frames)), out_(std::move(out_dir)) {}
   void on_detection(const DetectionEvent& d) override;
+  /// The picture's name for a frame index.
+  static std::string file_name(std::size_t index);
 
  private:
   std::set<std::size_t> frames_;

@@ -15,6 +15,7 @@
 #include <random>
 
 #include "core/error.hpp"
+#include "io/atomic_file.hpp"
 #include "io/boxes_io.hpp"
 #include "io/settings.hpp"
 #include "synth/camera_path.hpp"
@@ -59,7 +60,9 @@ void prepare_dir(const fs::path& dir) {
     throw InputError(fmt::format("{}: output path exists and is not a folder", dir.string()));
   if (fs::exists(dir) && !fs::is_empty(dir)) {
     if (!fs::exists(dir / "scenario.json"))
-      throw InputError(fmt::format("{}: output folder is not empty and is not an earlier synth output", dir.string()));
+      throw InputError(fmt::format("{}: output folder is not empty and is not an earlier synth output (no "
+                                   "scenario.json); synth would mix its files with the ones there: give another --out",
+                                   dir.string()));
     fs::remove_all(dir / "rgb");
     fs::remove_all(dir / "depth");
   }
@@ -137,10 +140,10 @@ cv::Vec2d exposure_motion(const PinholeCamera& cam, const RenderOutput& r, const
   return n ? sum / n : sum;
 }
 
-void write_pose_line(std::ofstream& out, double ts, const Eigen::Isometry3d& T) {
+std::string pose_line(double ts, const Eigen::Isometry3d& T) {
   const Eigen::Quaterniond q(T.rotation());
   const Eigen::Vector3d p = T.translation();
-  out << fmt::format("{:.6f} {:.6f} {:.6f} {:.6f} {:.6f} {:.6f} {:.6f} {:.6f}\n", ts, p.x(), p.y(), p.z(), q.x(), q.y(),
+  return fmt::format("{:.6f} {:.6f} {:.6f} {:.6f} {:.6f} {:.6f} {:.6f} {:.6f}\n", ts, p.x(), p.y(), p.z(), q.x(), q.y(),
                      q.z(), q.w());
 }
 
@@ -264,9 +267,8 @@ SynthSummary generate(const SynthConfig& cfg, const std::filesystem::path& out_d
         boxes[i] = person_boxes(r.ids, movers.people().size(), stamps[i], cfg, rng, gauss);
 
         const std::string name = ts_name(stamps[i]) + ".png";
-        if (!cv::imwrite((out_dir / "rgb" / name).string(), bgr, png_params) ||
-            !cv::imwrite((out_dir / "depth" / name).string(), depth, png_depth_params))
-          throw InputError(fmt::format("{}: cannot write frame {}", out_dir.string(), name));
+        write_image_atomically(out_dir / "rgb" / name, bgr, "colour image", png_params);
+        write_image_atomically(out_dir / "depth" / name, depth, "depth image", png_depth_params);
         for (std::size_t k = 0; k < preview_idx.size(); ++k)
           if (preview_idx[k] == i) preview[k] = PreviewFrame{bgr.clone(), depth.clone(), boxes[i].boxes, 5000.0};
         const std::size_t now = ++done;
@@ -290,17 +292,21 @@ SynthSummary generate(const SynthConfig& cfg, const std::filesystem::path& out_d
   summary.people = movers.people().size();
   summary.unknown_movers = movers.objects().size();
   {
-    std::ofstream rgb(out_dir / "rgb.txt"), dep(out_dir / "depth.txt"), gt(out_dir / "groundtruth.txt");
-    if (!rgb || !dep || !gt) throw InputError(fmt::format("{}: cannot write the frame lists", out_dir.string()));
-    rgb << "# color images\n# synthetic sequence: varslam synth --scenario " << cfg.scenario << "\n# timestamp filename\n";
-    dep << "# depth maps\n# synthetic sequence: varslam synth --scenario " << cfg.scenario << "\n# timestamp filename\n";
-    gt << "# ground truth trajectory (camera-to-world, relative to the first pose)\n# timestamp tx ty tz qx qy qz qw\n";
+    std::string rgb = "# color images\n# synthetic sequence: varslam synth --scenario " + cfg.scenario +
+                      "\n# timestamp filename\n";
+    std::string dep = "# depth maps\n# synthetic sequence: varslam synth --scenario " + cfg.scenario +
+                      "\n# timestamp filename\n";
+    std::string gt =
+        "# ground truth trajectory (camera-to-world, relative to the first pose)\n# timestamp tx ty tz qx qy qz qw\n";
     for (std::size_t i = 0; i < n_frames; ++i) {
       const std::string ts = ts_name(stamps[i]);
-      rgb << ts << " rgb/" << ts << ".png\n";
-      dep << ts << " depth/" << ts << ".png\n";
-      write_pose_line(gt, stamps[i], poses[i]);
+      rgb += ts + " rgb/" + ts + ".png\n";
+      dep += ts + " depth/" + ts + ".png\n";
+      gt += pose_line(stamps[i], poses[i]);
     }
+    write_file_atomically(out_dir / "rgb.txt", rgb, "frame list");
+    write_file_atomically(out_dir / "depth.txt", dep, "frame list");
+    write_file_atomically(out_dir / "groundtruth.txt", gt, "ground truth");
   }
   BoxesByTime by_time;
   for (std::size_t i = 0; i < n_frames; ++i) {
@@ -335,9 +341,10 @@ SynthSummary generate(const SynthConfig& cfg, const std::filesystem::path& out_d
                  {"depth_edge_holes", cfg.depth_edge_holes}, {"depth_max_m", cfg.depth_max_m},
                  {"random_holes_per_frame", cfg.random_holes_per_frame}, {"image_noise_sigma", cfg.image_noise_sigma},
                  {"motion_blur", cfg.motion_blur}, {"exposure_s", cfg.exposure_s}, {"exposure_drift", cfg.exposure_drift}};
-  std::ofstream(out_dir / "scenario.json") << j.dump(2) << "\n";
+  write_file_atomically(out_dir / "scenario.json", j.dump(2) + "\n", "scenario description");
 
-  if (cfg.preview && !preview.empty()) cv::imwrite((out_dir / "preview.png").string(), contact_sheet(preview), png_params);
+  if (cfg.preview && !preview.empty())
+    write_image_atomically(out_dir / "preview.png", contact_sheet(preview), "preview", png_params);
 
   summary.seconds_taken = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   return summary;

@@ -38,7 +38,7 @@ ViewerServer::ViewerServer(ViewerBoard& board, std::vector<Asset> assets, const 
   if (port_ <= 0)
     throw InputError(fmt::format("viewer: cannot listen on {}:{} ({}; --viewer-port 0 picks a free port)",
                                  options_.address, options_.port,
-                                 options_.port == 0 ? "no free port"
+                                 options_.port == 0 ? "the address is not this machine's, or no port is free"
                                                     : "the port is taken or the address is not this "
                                                       "machine's"));
   thread_ = std::thread([this] {

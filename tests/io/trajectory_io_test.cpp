@@ -82,14 +82,25 @@ TEST(TrajectoryIo, ErrorsNameFileAndLine) {
   EXPECT_THAT(input_error(dir / "missing.txt"), HasSubstr("missing.txt"));
 }
 
-TEST(TrajectoryIo, RepeatedTimestampKeepsTheLaterPoseLikeTheTumTools) {
+TEST(TrajectoryIo, RepeatedTimestampWithTheSamePoseKeepsTheLaterPoseLikeTheTumTools) {
   TempDir dir;
-  const auto file = dir.write("gt.txt", "1.0 0 0 0 0 0 0 1\n2.0 1 0 0 0 0 0 1\n2.0 5 0 0 0 0 0 1\n3.0 2 0 0 0 0 0 1\n");
+  // As in TUM fr2/desk_with_person: the same stamp twice, 1 mm and a tenth of a degree apart.
+  const auto file = dir.write("gt.txt", "1.0 0 0 0 0 0 0 1\n2.0 1 0 0 0 0 0 1\n2.0 1.001 0 0 0 0 0.001 1\n"
+                                        "3.0 2 0 0 0 0 0 1\n");
   const Trajectory t = read_tum_trajectory(file);
   ASSERT_EQ(t.size(), 3u);
   EXPECT_DOUBLE_EQ(t[1].timestamp, 2.0);
-  EXPECT_DOUBLE_EQ(t[1].T_wc.translation().x(), 5.0);
+  EXPECT_DOUBLE_EQ(t[1].T_wc.translation().x(), 1.001);
   EXPECT_DOUBLE_EQ(t[2].timestamp, 3.0);
+}
+
+TEST(TrajectoryIo, RepeatedTimestampWithAnotherPoseIsAnErrorNamingBothLines) {
+  TempDir dir;
+  const auto moved = dir.write("moved.txt", "# gt\n1.0 0 0 0 0 0 0 1\n2.0 1 0 0 0 0 0 1\n2.0 1.5 0 0 0 0 0 1\n");
+  EXPECT_THAT(input_error(moved), AllOf(HasSubstr(moved.string() + ":4: timestamp 2.000000 is also on line 3"),
+                                        HasSubstr("0.500 m"), HasSubstr("lines 3 and 4")));
+  const auto turned = dir.write("turned.txt", "1.0 0 0 0 0 0 0 1\n1.0 0 0 0 0 0 0.1 1\n");
+  EXPECT_THAT(input_error(turned), AllOf(HasSubstr(turned.string() + ":2:"), HasSubstr("11.42 deg")));
 }
 
 TEST(TrajectoryIo, WriteToUnwritablePathThrows) {
