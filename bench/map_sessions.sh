@@ -19,6 +19,7 @@ build_map() {  # name first count
 
 session() {  # map first count
   local dir="$OUT/$1_s$2${MAPPING:+_mapping}"
+  rm -rf "$dir"  # this script's own output of an earlier sitting
   "$BIN" run -d "$KITCHEN" --first "$2" -n "$3" --load-map "$OUT/$1.map" $([[ -n "${MAPPING:-}" ]] || echo --localization-only) --min-tracked-share 0 \
     -o "$dir" "${EXTRA[@]}" >"$dir.log" 2>&1 || { echo "$1 start $2: run failed (see $dir.log)"; return; }
   "$BIN" eval --gt "$KITCHEN/groundtruth.txt" --est "$dir/CameraTrajectory.txt" --map "$OUT/$1.map" \

@@ -1,8 +1,10 @@
 #include "mapfile/map_file.hpp"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 #include <zlib.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -488,21 +490,31 @@ SavedMap load_map_file(const std::filesystem::path& file) {
   return decode_map(ss.str(), file.string());
 }
 
+double intrinsics_difference(const PinholeCamera& a, const PinholeCamera& b) {
+  return std::max({std::abs(a.fx - b.fx) / b.fx, std::abs(a.fy - b.fy) / b.fy, std::abs(a.cx - b.cx) / b.width,
+                   std::abs(a.cy - b.cy) / b.height});
+}
+
 void check_map_compatible(const MapFingerprint& map, const PinholeCamera& camera, int n_levels, double scale_factor,
                           const std::string& what) {
   const PinholeCamera& m = map.camera;
   if (m.width != camera.width || m.height != camera.height)
     throw InputError(fmt::format("{}: the map was built with a {}x{} camera, this run's camera is {}x{}", what, m.width,
                                  m.height, camera.width, camera.height));
-  constexpr double kTolerance = 0.01;  // calibrations of one sensor differ by well under this
-  const auto off = [&](double a, double b, double scale) { return std::abs(a - b) > kTolerance * scale; };
-  if (off(m.fx, camera.fx, camera.fx) || off(m.fy, camera.fy, camera.fy) || off(m.cx, camera.cx, camera.width) ||
-      off(m.cy, camera.cy, camera.height))
+  // Two calibrations of one sensor differ by a few percent at most (self-calibration here: about 1 %); beyond 10 %
+  // it is another sensor or a wrong settings file.
+  constexpr double kSameSensor = 0.01, kAnotherSensor = 0.10;
+  const double difference = intrinsics_difference(camera, m);
+  if (difference > kAnotherSensor)
     throw InputError(
         fmt::format("{}: the map was built with another camera "
                     "(fx fy cx cy = {} {} {} {}; this run's: "
-                    "{} {} {} {}; at most 1 % apart)",
-                    what, m.fx, m.fy, m.cx, m.cy, camera.fx, camera.fy, camera.cx, camera.cy));
+                    "{} {} {} {}; {:.0f} % apart, at most 10 %)",
+                    what, m.fx, m.fy, m.cx, m.cy, camera.fx, camera.fy, camera.cx, camera.cy, 100 * difference));
+  if (difference > kSameSensor)
+    spdlog::warn("{}: the map was built with fx fy cx cy = {} {} {} {}; this run's intrinsics, {} {} {} {} ({:.1f} % "
+                 "apart), are the ones used",
+                 what, m.fx, m.fy, m.cx, m.cy, camera.fx, camera.fy, camera.cx, camera.cy, 100 * difference);
   if (map.n_levels != n_levels || std::abs(map.scale_factor - scale_factor) > 1e-9)
     throw InputError(
         fmt::format("{}: the map was built with an ORB pyramid of "

@@ -83,8 +83,11 @@ SavedMap decode_map(const std::string& bytes, const std::string& what);
 void save_map_file(const SavedMap& map, const std::filesystem::path& file);
 SavedMap load_map_file(const std::filesystem::path& file);
 
-/// InputError when the map was built with another camera (size, or intrinsics
-/// beyond 1 %) or scale pyramid.
+/// Largest relative difference of two cameras' intrinsics (fx, fy against fx, fy; cx, cy against width, height).
+double intrinsics_difference(const PinholeCamera& a, const PinholeCamera& b);
+
+/// InputError when the map was built with another camera (size, or intrinsics beyond 10 %: another sensor, not a
+/// recalibration) or scale pyramid. Between 1 and 10 % it warns: the caller's intrinsics are used.
 void check_map_compatible(const MapFingerprint& map, const PinholeCamera& camera, int n_levels, double scale_factor,
                           const std::string& what);
 

@@ -185,7 +185,7 @@ void Pipeline::calibrate_depth(std::span<const RgbdFrame> samples) {
 
 void Pipeline::start(std::span<const RgbdFrame> samples) {
   DepthRegistrationEvent reg = register_depth_if_needed(samples, settings_, cfg_);
-  if (pending_map_ && reg.found) adopt_map_camera(reg);
+  if (pending_map_ && (reg.found || !setting_given(settings_, "camera.fx"))) adopt_map_camera(reg);
   system_ = std::make_unique<slam::System>(cfg_, settings_.camera, settings_.close_depth_m(), options_.mode,
                                            relay_.get());
   if (pending_map_) {
@@ -201,19 +201,24 @@ void Pipeline::start(std::span<const RgbdFrame> samples) {
   emit(reg, &Observer::on_depth_registration);
 }
 
-// A loaded map brings the colour camera it was built with: this session's estimate from its own few frames is
-// compared and logged, and the map's is used (two estimates of one camera differ by about 1 %, enough to refuse).
+// A loaded map brings the colour camera it was built with, used unless the settings give intrinsics themselves: this
+// session's own estimate from its few frames is compared and logged (two estimates of one camera differ by ~1 %).
 void Pipeline::adopt_map_camera(DepthRegistrationEvent& reg) {
   const PinholeCamera& map = pending_map_->fingerprint.camera;
   PinholeCamera& now = settings_.camera;
-  spdlog::info("{}: the map's colour camera (fx {:.1f} fy {:.1f} cx {:.1f} cy {:.1f}) is used; this session estimated "
-               "fx {:.1f} fy {:.1f} cx {:.1f} cy {:.1f} from its own frames",
-               pending_map_file_.string(), map.fx, map.fy, map.cx, map.cy, now.fx, now.fy, now.cx, now.cy);
+  if (reg.found)
+    spdlog::info("{}: the map's colour camera (fx {:.1f} fy {:.1f} cx {:.1f} cy {:.1f}) is used; this session "
+                 "estimated fx {:.1f} fy {:.1f} cx {:.1f} cy {:.1f} from its own frames",
+                 pending_map_file_.string(), map.fx, map.fy, map.cx, map.cy, now.fx, now.fy, now.cx, now.cy);
+  else
+    spdlog::info("{}: the map's colour camera (fx {:.1f} fy {:.1f} cx {:.1f} cy {:.1f}) is used (the settings give "
+                 "no intrinsics)",
+                 pending_map_file_.string(), map.fx, map.fy, map.cx, map.cy);
   now.fx = map.fx;
   now.fy = map.fy;
   now.cx = map.cx;
   now.cy = map.cy;
-  reg.colour_camera = now;
+  if (reg.found) reg.colour_camera = now;
 }
 
 void Pipeline::install_person_filter() {
@@ -339,7 +344,7 @@ void Pipeline::load_map(const std::filesystem::path& file) {
   // The colour camera may still change (depth registration is estimated at start()): intrinsics are checked then,
   // size and pyramid now.
   PinholeCamera now = settings_.camera;
-  if (wants_depth_samples()) {
+  if (wants_depth_samples() || !setting_given(settings_, "camera.fx")) {
     now.fx = m.fingerprint.camera.fx;
     now.fy = m.fingerprint.camera.fy;
     now.cx = m.fingerprint.camera.cx;

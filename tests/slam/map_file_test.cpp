@@ -14,6 +14,7 @@
 #include "core/error.hpp"
 #include "io/dataset.hpp"
 #include "io/settings_registry.hpp"
+#include "pipeline/slam.hpp"
 #include "slam/e2e_support.hpp"
 #include "slam/system.hpp"
 
@@ -152,7 +153,9 @@ TEST(MapFile, AnotherCameraOrPyramidIsRefused) {
   EXPECT_NO_THROW(check_map_compatible(m.fingerprint, cam, m.fingerprint.n_levels, m.fingerprint.scale_factor, "x"));
   cam.fx *= 1.005;  // within 1 %: the same sensor recalibrated
   EXPECT_NO_THROW(check_map_compatible(m.fingerprint, cam, m.fingerprint.n_levels, m.fingerprint.scale_factor, "x"));
-  cam.fx *= 1.05;
+  cam.fx *= 1.05;  // another calibration of it: the caller's intrinsics are used, with a warning
+  EXPECT_NO_THROW(check_map_compatible(m.fingerprint, cam, m.fingerprint.n_levels, m.fingerprint.scale_factor, "x"));
+  cam.fx *= 1.1;  // another sensor
   try {
     check_map_compatible(m.fingerprint, cam, m.fingerprint.n_levels, m.fingerprint.scale_factor, "k.map");
     ADD_FAILURE();
@@ -165,6 +168,31 @@ TEST(MapFile, AnotherCameraOrPyramidIsRefused) {
                InputError);
   EXPECT_THROW(check_map_compatible(m.fingerprint, m.fingerprint.camera, 4, m.fingerprint.scale_factor, "x"),
                InputError);
+}
+
+// The map's camera is used unless the settings give intrinsics: none given, the map's; given a few percent off, the
+// caller's (with a warning); beyond 10 %, refused as another sensor.
+TEST(MapFile, TheMapsCameraIsUsedUnlessTheSettingsGiveIntrinsics) {
+  const PinholeCamera map = load_map_file(saved_map()).fingerprint.camera;
+  const RgbdFrame frame = open_dataset(static_sequence(), settings_for_dataset(static_sequence(), std::nullopt))->load(0);
+  const auto camera_of_session = [&](const std::vector<std::string>& overrides) {
+    Settings s;
+    apply_setting_overrides(s, overrides);
+    Pipeline p(s);
+    p.load_map(saved_map());
+    p.track(frame);
+    return p.settings().camera;
+  };
+  const PinholeCamera none_given = camera_of_session({"semantic.detector=none"});
+  EXPECT_EQ(none_given.fx, map.fx);
+  EXPECT_EQ(none_given.cx, map.cx);
+  const auto given = [&](double scale) {
+    return std::vector<std::string>{"semantic.detector=none", fmt::format("camera.fx={}", map.fx * scale),
+                                    fmt::format("camera.fy={}", map.fy * scale), fmt::format("camera.cx={}", map.cx),
+                                    fmt::format("camera.cy={}", map.cy)};
+  };
+  EXPECT_DOUBLE_EQ(camera_of_session(given(1.05)).fx, map.fx * 1.05);
+  EXPECT_THROW(camera_of_session(given(1.2)), InputError);
 }
 
 TEST(MapFile, LocalizationOnlyTracksInTheLoadedMapWithoutExtendingIt) {
