@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <mutex>
@@ -11,6 +12,7 @@
 #include <varslam/slam.hpp>
 
 #include "api/config_access.hpp"
+#include "mapfile/map_file.hpp"
 #include "pipeline/slam.hpp"
 #include "slam/keyframe.hpp"
 #include "slam/map.hpp"
@@ -295,8 +297,22 @@ void Slam::relocalize_near(const Pose& camera_to_world, double radius_m) {
 }
 
 void Slam::save_map(const std::string& file) {
-  const auto lock = impl_->lock_from_other_thread();
-  impl_->pipeline->save_map(file);
+  // Wait for local mapping to be idle without holding the session, so that tracking goes on meanwhile and the copy
+  // below (which pauses mapping between two keyframes) does not wait for a Local BA. Bounded: a map that keeps
+  // mapping gets its copy after the keyframe in progress.
+  for (int tries = 0; tries < 500; ++tries) {
+    {
+      const auto lock = impl_->lock_from_other_thread();
+      if (impl_->pipeline->mapping_idle()) break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  slam::SavedMap map;
+  {
+    const auto lock = impl_->lock_from_other_thread();
+    map = impl_->pipeline->map_to_save(file);
+  }
+  mapfile::save_map_file(map, file);  // encoding and writing: tracking goes on meanwhile
 }
 
 std::shared_ptr<const MapSnapshot> Slam::map_snapshot() const {

@@ -369,6 +369,11 @@ void Pipeline::relocalize_near(const Eigen::Isometry3d& T_wc, double radius_m) {
 }
 
 void Pipeline::save_map(const std::filesystem::path& file, const std::optional<Eigen::Isometry3d>& groundtruth_alignment) {
+  mapfile::save_map_file(map_to_save(file, groundtruth_alignment), file);
+}
+
+slam::SavedMap Pipeline::map_to_save(const std::filesystem::path& file,
+                                     const std::optional<Eigen::Isometry3d>& groundtruth_alignment) {
   if (!system_) throw InputError(fmt::format("{}: no map to save (no frame was tracked)", file.string()));
   mapfile::MapFingerprint fp;
   fp.camera = settings_.camera;
@@ -381,7 +386,7 @@ void Pipeline::save_map(const std::filesystem::path& file, const std::optional<E
   slam::SavedMap m = system_->snapshot_now(std::move(fp));
   if (m.keyframes.empty()) throw InputError(fmt::format("{}: no map to save (no keyframe)", file.string()));
   m.groundtruth_alignment = groundtruth_alignment;
-  mapfile::save_map_file(m, file);
+  return m;
 }
 
 Trajectory Pipeline::camera_trajectory(int* repaired) const {

@@ -89,6 +89,11 @@ class Pipeline {
   /// the caller has one, goes with it so runs in this map can be evaluated in its frame.
   void save_map(const std::filesystem::path& file,
                 const std::optional<Eigen::Isometry3d>& groundtruth_alignment = std::nullopt);
+  /// Local mapping has nothing to do right now: a copy taken now does not wait for it.
+  bool mapping_idle() const { return !system_ || system_->mapping_idle(); }
+  /// The copy save_map() writes (`file` names it in errors), for a caller that writes it outside its own lock.
+  slam::SavedMap map_to_save(const std::filesystem::path& file,
+                             const std::optional<Eigen::Isometry3d>& groundtruth_alignment = std::nullopt);
   /// The loaded map's alignment to ground truth, when it has one.
   const std::optional<Eigen::Isometry3d>& loaded_map_alignment() const { return loaded_alignment_; }
 

@@ -88,6 +88,7 @@ void LocalMapper::fail(std::exception_ptr error) {
   failed_ = true;
   queue_.clear();
   busy_ = false;
+  idle_cv_.notify_all();
 }
 
 void LocalMapper::start() {
@@ -106,12 +107,31 @@ void LocalMapper::stop() {
   thread_.join();
 }
 
+void LocalMapper::pause() {
+  std::unique_lock lock(queue_mutex_);
+  paused_ = true;
+  idle_cv_.wait(lock, [&] { return !busy_.load(); });
+}
+
+bool LocalMapper::idle() const {
+  std::lock_guard lock(queue_mutex_);
+  return !busy_.load() && queue_.empty();
+}
+
+void LocalMapper::resume() {
+  {
+    std::lock_guard lock(queue_mutex_);
+    paused_ = false;
+  }
+  queue_cv_.notify_all();
+}
+
 void LocalMapper::run() {
   for (;;) {
     KeyFramePtr kf;
     {
       std::unique_lock lock(queue_mutex_);
-      queue_cv_.wait(lock, [&] { return stop_requested_ || !queue_.empty(); });
+      queue_cv_.wait(lock, [&] { return stop_requested_ || (!paused_ && !queue_.empty()); });
       if (queue_.empty()) return;  // stop requested and nothing left
       kf = queue_.front();
       queue_.pop_front();
@@ -123,7 +143,11 @@ void LocalMapper::run() {
       fail(std::current_exception());  // reaches the caller through failure(); mapping stops here
       return;
     }
-    busy_ = false;
+    {
+      std::lock_guard lock(queue_mutex_);
+      busy_ = false;
+    }
+    idle_cv_.notify_all();
   }
 }
 

@@ -35,6 +35,12 @@ class LocalMapper final : public KeyframeSink {
   void start();
   /// Finishes the queued keyframes and joins the thread.
   void stop();
+  /// Real-time mode: waits until the thread is between keyframes and holds it there (keyframes keep queueing) until
+  /// resume(): the map is then consistent for a copy without waiting for the whole queue.
+  void pause();
+  void resume();
+  /// No keyframe being processed and none queued.
+  bool idle() const;
   bool running() const { return thread_.joinable(); }
 
   /// Receives a KeyframeMapped record per processed keyframe, on the mapping thread. Set before start().
@@ -65,6 +71,8 @@ class LocalMapper final : public KeyframeSink {
 
   mutable std::mutex queue_mutex_;
   std::condition_variable queue_cv_;
+  std::condition_variable idle_cv_;  // busy_ went false
+  bool paused_ = false;              // under queue_mutex_
   std::deque<KeyFramePtr> queue_;
   std::atomic<bool> busy_{false};
   std::atomic<bool> abort_ba_{false};

@@ -36,12 +36,19 @@ SavedMap System::snapshot(MapFingerprint fingerprint) const {
 }
 
 SavedMap System::snapshot_now(MapFingerprint fingerprint) {
+  // Between two keyframes of local mapping (and of the loop closing it runs) the map is consistent; the copy is
+  // made under the map's update lock so tracking, which may add a keyframe meanwhile, waits only for the copy.
   const bool pause = mode_ == RunMode::RealTime && mapper_.running();
-  if (pause) mapper_.stop();
+  if (pause) mapper_.pause();
+  struct Resume {
+    LocalMapper* mapper;
+    ~Resume() {
+      if (mapper) mapper->resume();
+    }
+  } resume{pause ? &mapper_ : nullptr};
   if (const auto failure = mapper_.failure()) std::rethrow_exception(failure);
-  SavedMap saved = snapshot(std::move(fingerprint));
-  if (pause) mapper_.start();
-  return saved;
+  std::unique_lock lock(map_.update_mutex());
+  return snapshot(std::move(fingerprint));
 }
 
 TrackOutcome System::process(const RgbdFrame& frame) {

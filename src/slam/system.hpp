@@ -39,6 +39,8 @@ class System {
   /// The same while running: in real-time mode local mapping is paused (its queue drained, so the map is
   /// consistent) for the copy and started again. Call from the thread that calls process().
   SavedMap snapshot_now(MapFingerprint fingerprint);
+  /// Local mapping has nothing to do right now (always true in deterministic mode).
+  bool mapping_idle() const { return mode_ != RunMode::RealTime || !mapper_.running() || mapper_.idle(); }
   void set_localization_only(bool on) { tracker_.set_localization_only(on); }
   void set_pose_hint(const Eigen::Isometry3d& T_wc, double radius_m) { tracker_.set_pose_hint(T_wc, radius_m); }
 
