@@ -7,7 +7,6 @@
 #include <fstream>
 #include <map>
 #include <optional>
-#include <sstream>
 #include <string_view>
 #include <vector>
 
@@ -17,15 +16,49 @@
 namespace varslam {
 namespace {
 
+// Settings files are a few kilobytes; a file far larger is not one (a video or a map given by mistake), and is
+// refused before it is read into memory.
+constexpr std::size_t kMaxSettingsBytes = 1 << 20;
+// Nodes a document may hold, counted through its aliases. yaml-cpp keeps an aliased node shared, so parsing stays
+// cheap, but every later walk visits it once per alias: a few hundred bytes of aliases of aliases ("billion
+// laughs") are billions of visits. Real settings files hold a few hundred nodes.
+constexpr std::size_t kMaxSettingsNodes = 100000;
+
 // OpenCV's "%YAML:1.0" header is not valid YAML; comment it out (not remove it) so line numbers stay true.
 std::string read_yaml_text(const std::filesystem::path& file) {
   std::ifstream in(file, std::ios::binary);
   if (!in) throw ConfigError(fmt::format("{}: cannot open settings file", file.string()));
-  std::stringstream ss;
-  ss << in.rdbuf();
-  std::string text = ss.str();
+  std::string text(kMaxSettingsBytes + 1, '\0');
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  if (text.size() > kMaxSettingsBytes)
+    throw ConfigError(fmt::format("{}: larger than {} KiB; a settings file is a few kilobytes of YAML",
+                                  file.string(), kMaxSettingsBytes / 1024));
   if (text.rfind("%YAML:", 0) == 0 || text.rfind("%YAML 1.0", 0) == 0) text.insert(0, "# ");
   return text;
+}
+
+// Visits every node as a reader would (an alias as often as it is used) and stops at the budget, before any
+// unbounded walk over the tree starts.
+void check_node_budget(const YAML::Node& root, const std::string& name) {
+  std::vector<YAML::Node> todo{root};
+  std::size_t visited = 0;
+  while (!todo.empty()) {
+    const YAML::Node n = todo.back();
+    todo.pop_back();
+    if (++visited > kMaxSettingsNodes)
+      throw ConfigError(fmt::format("{}: the YAML expands to more than {} values (aliases of aliases?); a settings "
+                                    "file holds a few hundred",
+                                    name, kMaxSettingsNodes));
+    if (n.IsMap()) {
+      for (const auto& kv : n) {
+        todo.push_back(kv.first);
+        todo.push_back(kv.second);
+      }
+    } else if (n.IsSequence()) {
+      for (const auto& item : n) todo.push_back(item);
+    }
+  }
 }
 
 // What the registry's per-key ranges cannot say: relations between keys.
@@ -88,14 +121,29 @@ void check_keys_are_names(const YAML::Node& node, const std::string& name) {
 
 }  // namespace
 
-Settings load_settings(const std::filesystem::path& file) {
-  YAML::Node root;
+YAML::Node parse_settings_yaml(const std::string& text, const std::string& name) {
+  if (text.size() > kMaxSettingsBytes)
+    throw ConfigError(fmt::format("{}: larger than {} KiB; settings are a few kilobytes of YAML", name,
+                                  kMaxSettingsBytes / 1024));
+  std::vector<YAML::Node> documents;
   try {
-    root = YAML::Load(read_yaml_text(file));
+    documents = YAML::LoadAll(text);
   } catch (const YAML::Exception& e) {
-    throw ConfigError(fmt::format("{}:{}: not valid YAML: {}", file.string(), e.mark.line + 1, e.msg));
+    throw ConfigError(fmt::format("{}:{}: not valid YAML: {}", name, e.mark.line + 1, e.msg));
   }
-  return settings_from_yaml(root, file);
+  // Only the first document would be read: what a later one says would be ignored without a word.
+  for (std::size_t i = 1; i < documents.size(); ++i) {
+    if (documents[i].IsNull()) continue;  // a trailing '---' with nothing after it
+    const int line = documents[i].Mark().line;
+    throw ConfigError(fmt::format("{}{}: a second YAML document (after a '---' line); a settings file is one "
+                                  "document: remove the '---' or move its keys into the first",
+                                  name, line >= 0 ? fmt::format(":{}", line + 1) : std::string()));
+  }
+  return documents.empty() ? YAML::Node() : documents.front();
+}
+
+Settings load_settings(const std::filesystem::path& file) {
+  return settings_from_yaml(parse_settings_yaml(read_yaml_text(file), file.string()), file);
 }
 
 Settings settings_from_yaml(const YAML::Node& root, const std::filesystem::path& file,
@@ -104,6 +152,7 @@ Settings settings_from_yaml(const YAML::Node& root, const std::filesystem::path&
   s.source = file;
   s.root = root;
   s.overrides = overrides;
+  check_node_budget(s.root, file.empty() ? std::string("<settings>") : file.string());
   if (!s.root.IsMap())
     throw ConfigError(fmt::format("{}: expected a YAML map of settings at the top level", file.string()));
   check_keys_are_names(s.root, file.empty() ? std::string("<settings>") : file.string());

@@ -1,6 +1,9 @@
 #include "io/settings.hpp"
 
+#include <fmt/format.h>
 #include <gmock/gmock.h>
+
+#include <chrono>
 #include <fstream>
 #include <gtest/gtest.h>
 
@@ -304,6 +307,42 @@ TEST(Settings, AKeyThatIsAMapOrAListIsRefusedByLine) {
               AllOf(HasSubstr(file.string() + ":4:"), HasSubstr("a key must be a name, not a map")));
   std::ofstream(file) << "camera: {fx: 500, fy: 500, cx: 320, cy: 240}\n? [a, b]\n: 1\n";
   EXPECT_THAT(config_error([&] { load_settings(file); }), HasSubstr("not a list"));
+}
+
+// "Billion laughs": 500 bytes of aliases of aliases are 10^10 values to a walk over the tree. It took minutes
+// before; now the read stops at the node budget, before any walk.
+TEST(Settings, AnAliasBombIsRefusedWithinASecond) {
+  std::string bomb = std::string(kOurs) + "tracking:\n  x0: &x0 [a, a, a, a, a, a, a, a, a, a]\n";
+  for (int i = 1; i < 10; ++i) {
+    bomb += fmt::format("  x{}: &x{} [", i, i);
+    for (int j = 0; j < 10; ++j) bomb += fmt::format("{}*x{}", j ? ", " : "", i - 1);
+    bomb += "]\n";
+  }
+  TempDir dir;
+  const auto file = dir.write("bomb.yaml", bomb);
+  const auto t0 = std::chrono::steady_clock::now();
+  EXPECT_THAT(config_error([&] { load_settings(file); }),
+              AllOf(HasSubstr("bomb.yaml: the YAML expands to more than 100000 values"), HasSubstr("aliases")));
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 1.0);
+  // Aliases as such are fine.
+  const auto fine =
+      dir.write("alias.yaml", std::string(kOurs) + "tracking: {kernel: &k huber}\nmapping: {kernel: *k}\n");
+  EXPECT_NO_THROW(load_settings(fine));
+}
+
+TEST(Settings, ASecondYamlDocumentIsAnErrorNotIgnored) {
+  TempDir dir;
+  const auto file = dir.write("two.yaml", std::string(kOurs) + "---\ncamera: {fx: 600}\n");
+  EXPECT_THAT(config_error([&] { load_settings(file); }),
+              AllOf(HasSubstr("two.yaml:13: a second YAML document"), HasSubstr("one document")));
+  // A header '---' and a trailing one with nothing after it start no second document.
+  EXPECT_NO_THROW(load_settings(dir.write("one.yaml", "%YAML:1.0\n---\n" + std::string(kOurs) + "---\n")));
+}
+
+TEST(Settings, AFileAboveOneMebibyteIsRefused) {
+  TempDir dir;
+  const auto file = dir.write("big.yaml", std::string(kOurs) + "# " + std::string(1 << 20, 'x') + "\n");
+  EXPECT_THAT(config_error([&] { load_settings(file); }), HasSubstr("big.yaml: larger than 1024 KiB"));
 }
 
 }  // namespace
