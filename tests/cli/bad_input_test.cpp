@@ -78,6 +78,17 @@ std::string run_on(const fs::path& seq, const std::string& name, const std::stri
   return "run -q -d " + seq.string() + " -o " + out_dir(name).string() + " " + extra;
 }
 
+// "Billion laughs": ten levels of ten aliases each, 10^10 values to a walk over the tree.
+std::string alias_bomb() {
+  std::string yaml = "x0: &x0 [a, a, a, a, a, a, a, a, a, a]\n";
+  for (int i = 1; i < 10; ++i) {
+    yaml += "x" + std::to_string(i) + ": &x" + std::to_string(i) + " [";
+    for (int j = 0; j < 10; ++j) yaml += (j ? ", *x" : "*x") + std::to_string(i - 1);
+    yaml += "]\n";
+  }
+  return yaml;
+}
+
 struct SettingsCase {
   std::string name, set_args, appended_yaml, expect;
 };
@@ -117,7 +128,13 @@ INSTANTIATE_TEST_SUITE_P(
         SettingsCase{"set_negative_count", "--set tracking.close_keyframe_gap=-5", "", "[1, 1000000]"},
         SettingsCase{"set_huge_cx", "--set camera.cx=1e300", "", "camera.cx"},
         SettingsCase{"set_broken_yaml", "'--set' 'camera.fx=[1, 2'", "", "not valid YAML"},
-        SettingsCase{"set_n_levels", "--set orb.n_levels=1000", "", "[1, 32]"}),
+        SettingsCase{"set_n_levels", "--set orb.n_levels=1000", "", "[1, 32]"},
+        // Settings that were silently ignored: a second spelling of a key, another case, a second document.
+        SettingsCase{"yaml_orbslam_fx_beside_ours", "", "Camera1.fx: 600\n", "both give camera.fx"},
+        SettingsCase{"yaml_orbslam_depth_factor", "", "RGBD.DepthMapFactor: 1000\n", "both give depth.factor"},
+        SettingsCase{"yaml_other_case", "", "Tracking.Kernel: huber\n", "write 'tracking.kernel'"},
+        SettingsCase{"yaml_second_document", "", "---\ncamera:\n  fx: 600\n", "a second YAML document"},
+        SettingsCase{"yaml_alias_bomb", "", alias_bomb(), "expands to more than 100000 values"}),
     [](const auto& param_info) { return param_info.param.name; });
 
 TEST(BadInput, AllZeroDepthIsAFailedRunThatSaysWhy) {
