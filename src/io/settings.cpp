@@ -3,11 +3,13 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <cerrno>
 #include <cmath>
 #include <fstream>
 #include <map>
 #include <optional>
 #include <string_view>
+#include <system_error>
 #include <vector>
 
 #include "core/error.hpp"
@@ -24,12 +26,33 @@ constexpr std::size_t kMaxSettingsBytes = 1 << 20;
 // laughs") are billions of visits. Real settings files hold a few hundred nodes.
 constexpr std::size_t kMaxSettingsNodes = 100000;
 
+std::string errno_text(int e) { return std::error_code(e, std::generic_category()).message(); }
+
+// What stands in the way of reading `file`, said before trying: a folder opens as a stream that reads nothing,
+// and a link to nowhere would otherwise be "cannot open".
+void check_settings_file(const std::filesystem::path& file) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::file_status link = fs::symlink_status(file, ec);
+  if (!fs::exists(link)) throw ConfigError(fmt::format("{}: settings file not found", file.string()));
+  const fs::file_status target = fs::status(file, ec);
+  if (fs::is_symlink(link) && !fs::exists(target))
+    throw ConfigError(fmt::format("{}: the settings file is a symbolic link to {}, which does not exist",
+                                  file.string(), fs::read_symlink(file, ec).string()));
+  if (fs::is_directory(target))
+    throw ConfigError(fmt::format("{}: is a folder, not a settings file", file.string()));
+}
+
 // OpenCV's "%YAML:1.0" header is not valid YAML; comment it out (not remove it) so line numbers stay true.
 std::string read_yaml_text(const std::filesystem::path& file) {
+  check_settings_file(file);
+  errno = 0;
   std::ifstream in(file, std::ios::binary);
-  if (!in) throw ConfigError(fmt::format("{}: cannot open settings file", file.string()));
+  if (!in) throw ConfigError(fmt::format("{}: cannot open the settings file: {}", file.string(), errno_text(errno)));
   std::string text(kMaxSettingsBytes + 1, '\0');
   in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  if (in.bad())
+    throw ConfigError(fmt::format("{}: cannot read the settings file: {}", file.string(), errno_text(errno)));
   text.resize(static_cast<std::size_t>(in.gcount()));
   if (text.size() > kMaxSettingsBytes)
     throw ConfigError(fmt::format("{}: larger than {} KiB; a settings file is a few kilobytes of YAML",

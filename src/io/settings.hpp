@@ -40,7 +40,8 @@ Settings default_settings();
 /// document, which would otherwise be ignored.
 YAML::Node parse_settings_yaml(const std::string& text, const std::string& name);
 /// Load a settings file; throws ConfigError naming the file and key on a missing or malformed value, and on any
-/// key the registry (core/setting_keys.hpp) does not declare.
+/// key the registry (core/setting_keys.hpp) does not declare; naming the file and the reason when it cannot be
+/// read (not found, a dangling symbolic link, a folder, no permission).
 Settings load_settings(const std::filesystem::path& file);
 /// The same from a parsed document (`file` names it in errors, `overrides` the keys set on the command line):
 /// re-reads camera, depth and ORB fields after `--set` overrides edited the document. A document that expands

@@ -137,6 +137,27 @@ INSTANTIATE_TEST_SUITE_P(
         SettingsCase{"yaml_alias_bomb", "", alias_bomb(), "expands to more than 100000 values"}),
     [](const auto& param_info) { return param_info.param.name; });
 
+// A settings file that is there but cannot be read, in the dataset folder or given: an error saying why, never a
+// run with the default camera and a warning that there is no settings file.
+TEST(BadInput, ASettingsFileThatCannotBeReadIsAnErrorSayingWhy) {
+  const fs::path seq = copy_of_base("dangling_settings");
+  fs::remove(seq / "settings.yaml");
+  fs::create_symlink(seq / "moved.yaml", seq / "settings.yaml");
+  const Outcome link = cli(run_on(seq, "dangling_settings"));
+  EXPECT_EQ(link.exit_code, 2) << link.output;
+  EXPECT_THAT(link.output, AllOf(HasSubstr("settings.yaml: the settings file is a symbolic link to"),
+                                 HasSubstr("moved.yaml, which does not exist")));
+  EXPECT_THAT(link.output, ::testing::Not(HasSubstr("default settings")));
+  const Outcome given = cli(run_on(base_sequence(), "dangling_given", "--settings " + (seq / "settings.yaml").string()));
+  EXPECT_EQ(given.exit_code, 2) << given.output;
+  EXPECT_THAT(given.output, HasSubstr("which does not exist"));
+  fs::remove(seq / "settings.yaml");
+  fs::create_directories(seq / "settings.yaml");
+  const Outcome folder = cli(run_on(seq, "folder_settings"));
+  EXPECT_EQ(folder.exit_code, 2) << folder.output;
+  EXPECT_THAT(folder.output, HasSubstr("settings.yaml: is a folder, not a settings file"));
+}
+
 TEST(BadInput, AllZeroDepthIsAFailedRunThatSaysWhy) {
   const fs::path seq = copy_of_base("zero_depth");
   for (const auto& e : fs::directory_iterator(seq / "depth"))

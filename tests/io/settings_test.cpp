@@ -6,6 +6,7 @@
 #include <chrono>
 #include <fstream>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include "core/error.hpp"
 #include "io/settings_registry.hpp"
@@ -340,6 +341,29 @@ TEST(Settings, AFileAboveOneMebibyteIsRefused) {
   TempDir dir;
   const auto file = dir.write("big.yaml", std::string(kOurs) + "# " + std::string(1 << 20, 'x') + "\n");
   EXPECT_THAT(config_error([&] { load_settings(file); }), HasSubstr("big.yaml: larger than 1024 KiB"));
+}
+
+// A settings file that is there but cannot be read: the error says which and why (it ran with the default camera
+// when the dataset's settings.yaml was a link to nowhere).
+TEST(Settings, AFileThatCannotBeReadSaysWhy) {
+  TempDir dir;
+  std::filesystem::create_symlink(dir / "gone.yaml", dir / "link.yaml");
+  EXPECT_THAT(config_error([&] { load_settings(dir / "link.yaml"); }),
+              AllOf(HasSubstr("link.yaml: the settings file is a symbolic link to"),
+                    HasSubstr("gone.yaml, which does not exist")));
+  std::filesystem::create_directories(dir / "folder.yaml");
+  EXPECT_THAT(config_error([&] { load_settings(dir / "folder.yaml"); }),
+              HasSubstr("folder.yaml: is a folder, not a settings file"));
+  EXPECT_THAT(config_error([&] { load_settings(dir / "nope.yaml"); }), HasSubstr("nope.yaml: settings file not found"));
+}
+
+TEST(Settings, AFileWithoutReadPermissionSaysSo) {
+  if (::geteuid() == 0) GTEST_SKIP() << "root reads files without permission";
+  TempDir dir;
+  const auto locked = dir.write("locked.yaml", kOurs);
+  std::filesystem::permissions(locked, std::filesystem::perms::none);
+  EXPECT_THAT(config_error([&] { load_settings(locked); }),
+              HasSubstr("locked.yaml: cannot open the settings file: Permission denied"));
 }
 
 }  // namespace
