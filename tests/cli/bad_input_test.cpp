@@ -158,6 +158,33 @@ TEST(BadInput, ASettingsFileThatCannotBeReadIsAnErrorSayingWhy) {
   EXPECT_THAT(folder.output, HasSubstr("settings.yaml: is a folder, not a settings file"));
 }
 
+// Options that only work beside another were ignored alone; debug frames past the run drew nothing. All are errors
+// naming both options (or the frames and the run's range) before any work.
+TEST(BadInput, AnOptionWithoutTheOneItNeedsIsAnErrorNamingBoth) {
+  const std::string seq = base_sequence().string();
+  const std::string gt = seq + "/groundtruth.txt";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {run_on(base_sequence(), "pace_alone", "--pace"), "--pace feeds frames at the dataset's rate in real-time "
+                                                        "mode: it only works with --realtime, which is not given"},
+      {run_on(base_sequence(), "port_alone", "--viewer-port 8123"), "--viewer-port"},
+      {run_on(base_sequence(), "hold_alone", "--viewer-hold"), "--viewer-hold"},
+      {"eval --gt " + gt + " --est " + gt + " --per-pair", "--per-pair"},
+      {"bench --peer-name other --out " + out_dir("peer_alone").string(), "--peer-name"}};
+  for (const auto& [args, flag] : cases) {
+    const Outcome o = cli(args);
+    EXPECT_EQ(o.exit_code, 2) << args << "\n" << o.output;
+    EXPECT_THAT(o.output, AllOf(HasSubstr(flag), HasSubstr("it only works with"))) << args;
+  }
+  const Outcome beyond = cli(run_on(base_sequence(), "debug_beyond", "-n 5 --debug-frames 2,50,900"));
+  EXPECT_EQ(beyond.exit_code, 2) << beyond.output;
+  EXPECT_THAT(beyond.output, AllOf(HasSubstr("--debug-frames 50,900: outside the frames this run processes, 0 to 4 "
+                                             "of the"),
+                                   HasSubstr(base_sequence().string())));
+  EXPECT_FALSE(fs::exists(out_path("debug_beyond") / "CameraTrajectory.txt")) << "the run should not have started";
+  const Outcome inside = cli(run_on(base_sequence(), "debug_inside", "-n 5 --debug-frames 2"));
+  EXPECT_EQ(inside.exit_code, 0) << inside.output;
+}
+
 TEST(BadInput, AllZeroDepthIsAFailedRunThatSaysWhy) {
   const fs::path seq = copy_of_base("zero_depth");
   for (const auto& e : fs::directory_iterator(seq / "depth"))
