@@ -232,14 +232,17 @@ std::string settings_yaml(const Settings& s) {
       "orb:\n  n_features: {}\n  scale_factor: {}\n  n_levels: {}\n  ini_th_fast: {}\n  min_th_fast: {}\n",
       s.orb.n_features, num(s.orb.scale_factor), s.orb.n_levels, s.orb.ini_th_fast, s.orb.min_th_fast);
 
-  // Keep the stage sections; drop the ones written above and ORB-SLAM's flat dotted keys (now in ours).
+  // Keep the stage sections; drop the ones written above, ORB-SLAM's flat dotted keys and its undotted spellings of
+  // ours (DepthMapFactor, ThDepth): written above in our spelling, they would be a second spelling of the key.
   if (s.root.IsMap()) {
     YAML::Emitter e;
     e << YAML::BeginMap;
     bool any = false;
     for (const auto& kv : s.root) {
       const std::string key = kv.first.as<std::string>();
-      if (key == "camera" || key == "depth" || key == "orb" || key.find('.') != std::string::npos) continue;
+      if (key == "camera" || key == "depth" || key == "orb" || key.find('.') != std::string::npos ||
+          spec_for_spelling(key))
+        continue;
       e << YAML::Key << key << YAML::Value << kv.second;
       any = true;
     }

@@ -174,16 +174,6 @@ std::optional<Found> find_value(const YAML::Node& root, const KeySpec& k) {
   return std::nullopt;
 }
 
-// The declaration a document key stands for: our own name or one of the aliases.
-const KeySpec* spec_for_spelling(std::string_view spelled) {
-  for (const KeySpec& k : setting_keys::all()) {
-    if (k.name == spelled) return &k;
-    for (std::string_view alias : split(k.aliases, '|'))
-      if (alias == spelled) return &k;
-  }
-  return nullptr;
-}
-
 bool is_ignored_foreign_key(std::string_view key) {
   for (std::string_view ignored : setting_keys::kIgnoredForeignKeys) {
     if (ignored.back() == '.' ? key.substr(0, ignored.size()) == ignored : key == ignored) return true;
@@ -351,6 +341,15 @@ std::string number_text(double v) {
 }
 
 }  // namespace
+
+const KeySpec* spec_for_spelling(std::string_view spelled) {
+  for (const KeySpec& k : setting_keys::all()) {
+    if (k.name == spelled) return &k;
+    for (std::string_view alias : split(k.aliases, '|'))
+      if (alias == spelled) return &k;
+  }
+  return nullptr;
+}
 
 const KeySpec& key_spec(std::string_view name) {
   if (const KeySpec* k = setting_keys::find(name)) return *k;

@@ -203,6 +203,10 @@ ORBextractor.minThFAST: 7
 Viewer.KeyFrameSize: 0.05
 )");
   const Settings s = load_settings(file);
+  // Written in our layout it reads again: DepthMapFactor and ThDepth are not kept beside depth.factor/th_depth
+  // (found by fuzzing once two spellings of a key became an error).
+  save_settings(s, dir / "again.yaml");
+  EXPECT_DOUBLE_EQ(load_settings(dir / "again.yaml").depth_factor, 5000.0);
   EXPECT_DOUBLE_EQ(s.camera.fx, 517.306408);
   EXPECT_DOUBLE_EQ(s.camera.cy, 255.313989);
   EXPECT_DOUBLE_EQ(s.camera.k1, 0.262383);
