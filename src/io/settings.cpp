@@ -2,12 +2,14 @@
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
+#include <yaml-cpp/eventhandler.h>
 
 #include <cerrno>
 #include <cmath>
 #include <fstream>
 #include <map>
 #include <optional>
+#include <sstream>
 #include <string_view>
 #include <system_error>
 #include <vector>
@@ -144,25 +146,63 @@ void check_keys_are_names(const YAML::Node& node, const std::string& name) {
 
 }  // namespace
 
+namespace {
+
+// Whether a YAML document holds anything but an empty value, and the line where that starts.
+class DocumentContent final : public YAML::EventHandler {
+ public:
+  std::optional<int> line;  // 0-based; empty while nothing was seen
+  void OnDocumentStart(const YAML::Mark&) override {}
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnAlias(const YAML::Mark& m, YAML::anchor_t) override { seen(m); }
+  void OnScalar(const YAML::Mark& m, const std::string&, YAML::anchor_t, const std::string&) override { seen(m); }
+  void OnSequenceStart(const YAML::Mark& m, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
+    seen(m);
+  }
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark& m, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
+    seen(m);
+  }
+  void OnMapEnd() override {}
+
+ private:
+  void seen(const YAML::Mark& m) {
+    if (!line) line = m.line;
+  }
+};
+
+// Only the first document is read: what a later one says would be ignored without a word. The documents are
+// walked by count, not with YAML::LoadAll: yaml-cpp 0.7 reports empty documents forever on some malformed input
+// (found by fuzzing), and LoadAll then never returns.
+void check_one_document(const std::string& text, const std::string& name) {
+  constexpr int kMaxDocuments = 1000;
+  std::istringstream in(text);
+  YAML::Parser parser(in);
+  for (int i = 0; i < kMaxDocuments; ++i) {
+    DocumentContent doc;
+    if (!parser.HandleNextDocument(doc)) return;
+    if (i > 0 && doc.line)  // an empty one (a trailing '---') adds nothing
+      throw ConfigError(fmt::format("{}:{}: a second YAML document (after a '---' line); a settings file is one "
+                                    "document: remove the '---' or move its keys into the first",
+                                    name, *doc.line + 1));
+  }
+  throw ConfigError(fmt::format("{}: more than {} YAML documents; a settings file is one", name, kMaxDocuments));
+}
+
+}  // namespace
+
 YAML::Node parse_settings_yaml(const std::string& text, const std::string& name) {
   if (text.size() > kMaxSettingsBytes)
     throw ConfigError(fmt::format("{}: larger than {} KiB; settings are a few kilobytes of YAML", name,
                                   kMaxSettingsBytes / 1024));
-  std::vector<YAML::Node> documents;
   try {
-    documents = YAML::LoadAll(text);
+    YAML::Node root = YAML::Load(text);
+    check_one_document(text, name);
+    return root;
   } catch (const YAML::Exception& e) {
     throw ConfigError(fmt::format("{}:{}: not valid YAML: {}", name, e.mark.line + 1, e.msg));
   }
-  // Only the first document would be read: what a later one says would be ignored without a word.
-  for (std::size_t i = 1; i < documents.size(); ++i) {
-    if (documents[i].IsNull()) continue;  // a trailing '---' with nothing after it
-    const int line = documents[i].Mark().line;
-    throw ConfigError(fmt::format("{}{}: a second YAML document (after a '---' line); a settings file is one "
-                                  "document: remove the '---' or move its keys into the first",
-                                  name, line >= 0 ? fmt::format(":{}", line + 1) : std::string()));
-  }
-  return documents.empty() ? YAML::Node() : documents.front();
 }
 
 Settings load_settings(const std::filesystem::path& file) {

@@ -339,6 +339,9 @@ TEST(Settings, ASecondYamlDocumentIsAnErrorNotIgnored) {
               AllOf(HasSubstr("two.yaml:13: a second YAML document"), HasSubstr("one document")));
   // A header '---' and a trailing one with nothing after it start no second document.
   EXPECT_NO_THROW(load_settings(dir.write("one.yaml", "%YAML:1.0\n---\n" + std::string(kOurs) + "---\n")));
+  // Found by fuzzing: yaml-cpp 0.7 reports empty documents forever after this (YAML::LoadAll never returns).
+  const auto forever = dir.write("forever.yaml", ",t" + std::string(57, '\xf3') + "rabking:\n  k_file adaptive\n");
+  EXPECT_THAT(config_error([&] { load_settings(forever); }), HasSubstr("forever.yaml: more than 1000 YAML documents"));
 }
 
 TEST(Settings, AFileAboveOneMebibyteIsRefused) {
