@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 #include <yaml-cpp/eventhandler.h>
 
+#include <array>
 #include <cerrno>
 #include <cmath>
 #include <fstream>
@@ -51,14 +52,17 @@ std::string read_yaml_text(const std::filesystem::path& file) {
   errno = 0;
   std::ifstream in(file, std::ios::binary);
   if (!in) throw ConfigError(fmt::format("{}: cannot open the settings file: {}", file.string(), errno_text(errno)));
-  std::string text(kMaxSettingsBytes + 1, '\0');
-  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  // In pieces up to the limit: a pipe has no size to check first, and a settings file is small.
+  std::string text;
+  std::array<char, 16384> piece;
+  while (in.read(piece.data(), piece.size()) || in.gcount() > 0) {
+    text.append(piece.data(), static_cast<std::size_t>(in.gcount()));
+    if (text.size() > kMaxSettingsBytes)
+      throw ConfigError(fmt::format("{}: larger than {} KiB; a settings file is a few kilobytes of YAML",
+                                    file.string(), kMaxSettingsBytes / 1024));
+  }
   if (in.bad())
     throw ConfigError(fmt::format("{}: cannot read the settings file: {}", file.string(), errno_text(errno)));
-  text.resize(static_cast<std::size_t>(in.gcount()));
-  if (text.size() > kMaxSettingsBytes)
-    throw ConfigError(fmt::format("{}: larger than {} KiB; a settings file is a few kilobytes of YAML",
-                                  file.string(), kMaxSettingsBytes / 1024));
   if (text.rfind("%YAML:", 0) == 0 || text.rfind("%YAML 1.0", 0) == 0) text.insert(0, "# ");
   return text;
 }

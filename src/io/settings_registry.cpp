@@ -476,9 +476,14 @@ void apply_setting_overrides(Settings& settings, const std::vector<std::string>&
 }
 
 std::string nearest_key(std::string_view name, bool section_only) {
+  // Close enough to be a typo: a third of the name, at least 2 edits (a section typo inside a full key included).
+  const std::size_t allowed = std::max<std::size_t>(2, name.size() / 3);
   std::string best;
   std::size_t best_d = SIZE_MAX;
   const auto consider = [&](std::string_view candidate) {
+    // The distance is at least the difference in length: a candidate that far off cannot be the answer.
+    const std::size_t length_gap = std::max(name.size(), candidate.size()) - std::min(name.size(), candidate.size());
+    if (length_gap > allowed) return;
     const std::size_t d = edit_distance(name, candidate);
     if (d < best_d) {
       best_d = d;
@@ -490,8 +495,6 @@ std::string nearest_key(std::string_view name, bool section_only) {
   } else {
     for (const KeySpec& k : setting_keys::all()) consider(k.name);
   }
-  // Close enough to be a typo: a third of the name, at least 2 edits (a section typo inside a full key included).
-  const std::size_t allowed = std::max<std::size_t>(2, name.size() / 3);
   return best_d <= allowed ? best : std::string();
 }
 
