@@ -26,8 +26,9 @@ namespace {
 constexpr std::size_t kMaxSettingsBytes = 1 << 20;
 // Nodes a document may hold, counted through its aliases. yaml-cpp keeps an aliased node shared, so parsing stays
 // cheap, but every later walk visits it once per alias: a few hundred bytes of aliases of aliases ("billion
-// laughs") are billions of visits. Real settings files hold a few hundred nodes.
-constexpr std::size_t kMaxSettingsNodes = 100000;
+// laughs") are billions of visits, and an alias inside its own anchor is a cycle no walk leaves. Real settings
+// files hold under a hundred values; the budget is a hundred times that, and walking it takes milliseconds.
+constexpr std::size_t kMaxSettingsNodes = 10000;
 
 std::string errno_text(int e) { return std::error_code(e, std::generic_category()).message(); }
 
@@ -76,8 +77,8 @@ void check_node_budget(const YAML::Node& root, const std::string& name) {
     const YAML::Node n = todo.back();
     todo.pop_back();
     if (++visited > kMaxSettingsNodes)
-      throw ConfigError(fmt::format("{}: the YAML expands to more than {} values (aliases of aliases?); a settings "
-                                    "file holds a few hundred",
+      throw ConfigError(fmt::format("{}: the YAML expands to more than {} values (aliases of aliases, or an alias "
+                                    "inside its own anchor); a settings file holds a hundred or so",
                                     name, kMaxSettingsNodes));
     if (n.IsMap()) {
       for (const auto& kv : n) {
@@ -147,10 +148,6 @@ void check_keys_are_names(const YAML::Node& node, const std::string& name) {
     for (const auto& item : node) check_keys_are_names(item, name);
   }
 }
-
-}  // namespace
-
-namespace {
 
 // Whether a YAML document holds anything but an empty value, and the line where that starts.
 class DocumentContent final : public YAML::EventHandler {

@@ -45,7 +45,7 @@ YAML::Node parse_settings_yaml(const std::string& text, const std::string& name)
 Settings load_settings(const std::filesystem::path& file);
 /// The same from a parsed document (`file` names it in errors, `overrides` the keys set on the command line):
 /// re-reads camera, depth and ORB fields after `--set` overrides edited the document. A document that expands
-/// (through aliases) to more than 100000 values is refused before it is walked.
+/// (through aliases) to more than 10000 values is refused before it is walked.
 Settings settings_from_yaml(const YAML::Node& root, const std::filesystem::path& file,
                             const std::map<std::string, std::string>& overrides = {});
 /// Our own YAML layout of `s` (what `synth` puts next to a generated sequence), and writing it to a file.

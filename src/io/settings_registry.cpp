@@ -563,7 +563,7 @@ std::string settings_reference_markdown() {
          "`Camera1.fx`), a name in another case (`Tracking.Kernel`), a value of the wrong type, NaN or a value "
          "outside its range is an error that names the file and line (or the `--set`) and the nearest valid key. "
          "A settings file is one YAML document of at most 1 MiB that expands, through its aliases, to at most "
-         "100000 values.\n";
+         "10000 values.\n";
   std::string_view section;
   for (const KeySpec& k : setting_keys::all()) {
     const auto [sec, key] = section_and_key(k.name);
