@@ -9,6 +9,7 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <stdexcept>
 #include <thread>
 
 #include "core/error.hpp"
@@ -77,6 +78,19 @@ void check_first_frame(std::size_t first, std::size_t frames) {
   if (first < frames) return;
   throw InputError(fmt::format("--first {}: the dataset has {} frames, so --first is at most {}", first, frames,
                                frames == 0 ? 0 : frames - 1));
+}
+
+void check_flag_needs(const CLI::App& app) {
+  for (const CLI::App* cmd : app.get_subcommands())  // the ones given on the command line
+    for (const FlagNeed& n : kFlagNeeds) {
+      if (cmd->get_name() != n.command) continue;
+      const CLI::Option* flag = cmd->get_option_no_throw(std::string(n.flag));
+      const CLI::Option* needs = cmd->get_option_no_throw(std::string(n.needs));
+      if (!flag || !needs)
+        throw std::logic_error(fmt::format("kFlagNeeds: `{}` has no option {} or {}", n.command, n.flag, n.needs));
+      if (flag->count() > 0 && needs->count() == 0)
+        throw InputError(fmt::format("{} {}: it only works with {}, which is not given", n.flag, n.what, n.needs));
+    }
 }
 
 CLI::Validator finite_range(double lo, double hi, bool lo_open) {

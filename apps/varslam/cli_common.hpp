@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <atomic>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "io/settings.hpp"
@@ -10,6 +11,32 @@
 #include "run/dataset_run.hpp"
 
 namespace varslam::cli {
+
+/// An option that only means something beside another one: alone it would be ignored, so it is an error.
+struct FlagNeed {
+  std::string_view command;  // the subcommand both belong to
+  std::string_view flag;     // given alone it would do nothing...
+  std::string_view needs;    // ...without this one
+  std::string_view what;     // what `flag` does, for the message
+};
+
+// Every such pair of every subcommand, checked in one place (check_flag_needs).
+inline constexpr FlagNeed kFlagNeeds[] = {
+    {"run", "--pace", "--realtime", "feeds frames at the dataset's rate in real-time mode"},
+    {"run", "--viewer-port", "--viewer", "sets the live viewer's port"},
+    {"run", "--viewer-address", "--viewer", "sets the live viewer's address"},
+    {"run", "--viewer-fps", "--viewer", "limits the frames sent to the live viewer"},
+    {"run", "--viewer-hold", "--viewer", "keeps the live viewer up after the run"},
+    {"run", "--viewer-wait", "--viewer", "waits for a browser at the live viewer"},
+    {"run", "--localization-only", "--load-map", "needs a map to localize in"},
+    {"eval", "--per-pair", "--json", "puts each pair's error into the JSON file"},
+    {"bench", "--peer-trajectory", "--peer", "names the trajectory file the peer writes"},
+    {"bench", "--peer-name", "--peer", "names the peer's column"},
+};
+
+/// Throws InputError naming both options when a parsed subcommand has an option of kFlagNeeds without the one it
+/// needs; std::logic_error when the table names an option the subcommand does not have.
+void check_flag_needs(const CLI::App& app);
 
 /// A number option's check: finite (CLI11's own ranges let NaN through) and within [lo, hi] (or (lo, hi] when
 /// `lo_open`); the error names the value and the range, and CLI11 names the option.

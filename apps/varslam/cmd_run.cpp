@@ -128,8 +128,6 @@ void add_run_command(CLI::App& app) {
     ro.min_tracked_share = o->min_tracked_share;
     if (!o->save_map.empty()) ro.save_map = o->save_map;
     if (!o->load_map.empty()) ro.load_map = o->load_map;
-    if (o->localization_only && !ro.load_map)
-      throw InputError("--localization-only needs a map to localize in: give --load-map FILE");
     ro.localization_only = o->localization_only;
     ro.stop = &stop_on_signals();
     std::unique_ptr<viewer::LiveViewer> live_viewer;

@@ -5,6 +5,7 @@
 #include <exception>
 #include <filesystem>
 
+#include "cli_common.hpp"
 #include "commands.hpp"
 #include "core/error.hpp"
 #include "io/file_problem.hpp"
@@ -28,6 +29,8 @@ int main(int argc, char** argv) {
   varslam::cli::add_settings_command(app);
   varslam::cli::add_view_command(app);
   varslam::cli::add_bag_command(app);
+  // Runs once the whole command line is parsed, before the subcommand's own callback starts any work.
+  app.parse_complete_callback([&app] { varslam::cli::check_flag_needs(app); });
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

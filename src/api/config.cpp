@@ -31,14 +31,8 @@ Config Config::from_file(const std::string& path) {
 }
 
 Config Config::from_yaml(const std::string& yaml, const std::string& name) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml);
-  } catch (const YAML::Exception& e) {
-    throw ConfigError(fmt::format("{}: not YAML: {}", name, e.what()));
-  }
   Config c;
-  c.impl_->settings = settings_from_yaml(root, name);
+  c.impl_->settings = settings_from_yaml(parse_settings_yaml(yaml, name), name);
   c.impl_->settings.source.clear();  // not a file: relative paths are relative to the working folder
   return c;
 }

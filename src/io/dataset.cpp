@@ -206,8 +206,12 @@ std::unique_ptr<Dataset> open_dataset(const std::filesystem::path& dir, const Se
 }
 
 Settings settings_for_dataset(const std::filesystem::path& dir, const std::optional<std::filesystem::path>& file) {
-  Settings s = file ? load_settings(*file)
-                    : fs::exists(dir / "settings.yaml") ? load_settings(dir / "settings.yaml") : default_settings();
+  // Anything named settings.yaml (a link to nowhere, a folder, a file we may not read) is meant as the settings:
+  // reading it says what is wrong, instead of running with the default camera.
+  const fs::path in_folder = dir / "settings.yaml";
+  std::error_code ec;
+  const bool named = fs::exists(fs::symlink_status(in_folder, ec));
+  Settings s = file ? load_settings(*file) : named ? load_settings(in_folder) : default_settings();
   s.dataset_dir = dir;
   if (!s.source.empty()) return s;
   if (fs::is_directory(dir) && &detect_layout(dir) == &kOpenLoris) s.depth_factor = 1000.0;

@@ -40,7 +40,8 @@ class Dataset {
 std::unique_ptr<Dataset> open_dataset(const std::filesystem::path& dir, const Settings& settings);
 
 /// The settings for a dataset: the explicit file if given, else <dir>/settings.yaml if present, else
-/// default_settings() with a warning saying so (depth factor 1000 for an OpenLORIS folder).
+/// default_settings() with a warning saying so (depth factor 1000 for an OpenLORIS folder). A settings.yaml that is
+/// there but cannot be read (a dangling link, a folder, no permission) is a ConfigError saying why.
 Settings settings_for_dataset(const std::filesystem::path& dir, const std::optional<std::filesystem::path>& file);
 
 /// Decodes frames [first, first + count) ahead on its own thread so decoding overlaps with processing.

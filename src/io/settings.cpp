@@ -2,13 +2,17 @@
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
+#include <yaml-cpp/eventhandler.h>
 
+#include <array>
+#include <cerrno>
 #include <cmath>
 #include <fstream>
 #include <map>
 #include <optional>
 #include <sstream>
 #include <string_view>
+#include <system_error>
 #include <vector>
 
 #include "core/error.hpp"
@@ -18,15 +22,74 @@
 namespace varslam {
 namespace {
 
+// Settings files are a few kilobytes; a file far larger is not one (a video or a map given by mistake), and is
+// refused before it is read into memory.
+constexpr std::size_t kMaxSettingsBytes = 1 << 20;
+// Nodes a document may hold, counted through its aliases. yaml-cpp keeps an aliased node shared, so parsing stays
+// cheap, but every later walk visits it once per alias: a few hundred bytes of aliases of aliases ("billion
+// laughs") are billions of visits, and an alias inside its own anchor is a cycle no walk leaves. Real settings
+// files hold under a hundred values; the budget is a hundred times that, and walking it takes milliseconds.
+constexpr std::size_t kMaxSettingsNodes = 10000;
+
+std::string errno_text(int e) { return std::error_code(e, std::generic_category()).message(); }
+
+// What stands in the way of reading `file`, said before trying: a folder opens as a stream that reads nothing,
+// and a link to nowhere would otherwise be "cannot open".
+void check_settings_file(const std::filesystem::path& file) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::file_status link = fs::symlink_status(file, ec);
+  if (!fs::exists(link)) throw ConfigError(fmt::format("{}: settings file not found", file.string()));
+  const fs::file_status target = fs::status(file, ec);
+  if (fs::is_symlink(link) && !fs::exists(target))
+    throw ConfigError(fmt::format("{}: the settings file is a symbolic link to {}, which does not exist",
+                                  file.string(), fs::read_symlink(file, ec).string()));
+  if (fs::is_directory(target))
+    throw ConfigError(fmt::format("{}: is a folder, not a settings file", file.string()));
+}
+
 // OpenCV's "%YAML:1.0" header is not valid YAML; comment it out (not remove it) so line numbers stay true.
 std::string read_yaml_text(const std::filesystem::path& file) {
+  check_settings_file(file);
+  errno = 0;
   std::ifstream in(file, std::ios::binary);
-  if (!in) throw ConfigError(fmt::format("{}: cannot open settings file", file.string()));
-  std::stringstream ss;
-  ss << in.rdbuf();
-  std::string text = ss.str();
+  if (!in) throw ConfigError(fmt::format("{}: cannot open the settings file: {}", file.string(), errno_text(errno)));
+  // In pieces up to the limit: a pipe has no size to check first, and a settings file is small.
+  std::string text;
+  std::array<char, 16384> piece;
+  while (in.read(piece.data(), piece.size()) || in.gcount() > 0) {
+    text.append(piece.data(), static_cast<std::size_t>(in.gcount()));
+    if (text.size() > kMaxSettingsBytes)
+      throw ConfigError(fmt::format("{}: larger than {} KiB; a settings file is a few kilobytes of YAML",
+                                    file.string(), kMaxSettingsBytes / 1024));
+  }
+  if (in.bad())
+    throw ConfigError(fmt::format("{}: cannot read the settings file: {}", file.string(), errno_text(errno)));
   if (text.rfind("%YAML:", 0) == 0 || text.rfind("%YAML 1.0", 0) == 0) text.insert(0, "# ");
   return text;
+}
+
+// Visits every node as a reader would (an alias as often as it is used) and stops at the budget, before any
+// unbounded walk over the tree starts.
+void check_node_budget(const YAML::Node& root, const std::string& name) {
+  std::vector<YAML::Node> todo{root};
+  std::size_t visited = 0;
+  while (!todo.empty()) {
+    const YAML::Node n = todo.back();
+    todo.pop_back();
+    if (++visited > kMaxSettingsNodes)
+      throw ConfigError(fmt::format("{}: the YAML expands to more than {} values (aliases of aliases, or an alias "
+                                    "inside its own anchor); a settings file holds a hundred or so",
+                                    name, kMaxSettingsNodes));
+    if (n.IsMap()) {
+      for (const auto& kv : n) {
+        todo.push_back(kv.first);
+        todo.push_back(kv.second);
+      }
+    } else if (n.IsSequence()) {
+      for (const auto& item : n) todo.push_back(item);
+    }
+  }
 }
 
 // What the registry's per-key ranges cannot say: relations between keys.
@@ -87,16 +150,65 @@ void check_keys_are_names(const YAML::Node& node, const std::string& name) {
   }
 }
 
+// Whether a YAML document holds anything but an empty value, and the line where that starts.
+class DocumentContent final : public YAML::EventHandler {
+ public:
+  std::optional<int> line;  // 0-based; empty while nothing was seen
+  void OnDocumentStart(const YAML::Mark&) override {}
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnAlias(const YAML::Mark& m, YAML::anchor_t) override { seen(m); }
+  void OnScalar(const YAML::Mark& m, const std::string&, YAML::anchor_t, const std::string&) override { seen(m); }
+  void OnSequenceStart(const YAML::Mark& m, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
+    seen(m);
+  }
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark& m, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
+    seen(m);
+  }
+  void OnMapEnd() override {}
+
+ private:
+  void seen(const YAML::Mark& m) {
+    if (!line) line = m.line;
+  }
+};
+
+// Only the first document is read: what a later one says would be ignored without a word. The documents are
+// walked by count, not with YAML::LoadAll: yaml-cpp 0.7 reports empty documents forever on some malformed input
+// (found by fuzzing), and LoadAll then never returns.
+void check_one_document(const std::string& text, const std::string& name) {
+  constexpr int kMaxDocuments = 1000;
+  std::istringstream in(text);
+  YAML::Parser parser(in);
+  for (int i = 0; i < kMaxDocuments; ++i) {
+    DocumentContent doc;
+    if (!parser.HandleNextDocument(doc)) return;
+    if (i > 0 && doc.line)  // an empty one (a trailing '---') adds nothing
+      throw ConfigError(fmt::format("{}:{}: a second YAML document (after a '---' line); a settings file is one "
+                                    "document: remove the '---' or move its keys into the first",
+                                    name, *doc.line + 1));
+  }
+  throw ConfigError(fmt::format("{}: more than {} YAML documents; a settings file is one", name, kMaxDocuments));
+}
+
 }  // namespace
 
-Settings load_settings(const std::filesystem::path& file) {
-  YAML::Node root;
+YAML::Node parse_settings_yaml(const std::string& text, const std::string& name) {
+  if (text.size() > kMaxSettingsBytes)
+    throw ConfigError(fmt::format("{}: larger than {} KiB; settings are a few kilobytes of YAML", name,
+                                  kMaxSettingsBytes / 1024));
   try {
-    root = YAML::Load(read_yaml_text(file));
+    YAML::Node root = YAML::Load(text);
+    check_one_document(text, name);
+    return root;
   } catch (const YAML::Exception& e) {
-    throw ConfigError(fmt::format("{}:{}: not valid YAML: {}", file.string(), e.mark.line + 1, e.msg));
+    throw ConfigError(fmt::format("{}:{}: not valid YAML: {}", name, e.mark.line + 1, e.msg));
   }
-  return settings_from_yaml(root, file);
+}
+
+Settings load_settings(const std::filesystem::path& file) {
+  return settings_from_yaml(parse_settings_yaml(read_yaml_text(file), file.string()), file);
 }
 
 Settings settings_from_yaml(const YAML::Node& root, const std::filesystem::path& file,
@@ -105,6 +217,7 @@ Settings settings_from_yaml(const YAML::Node& root, const std::filesystem::path&
   s.source = file;
   s.root = root;
   s.overrides = overrides;
+  check_node_budget(s.root, file.empty() ? std::string("<settings>") : file.string());
   if (!s.root.IsMap())
     throw ConfigError(fmt::format("{}: expected a YAML map of settings at the top level", file.string()));
   check_keys_are_names(s.root, file.empty() ? std::string("<settings>") : file.string());
@@ -161,14 +274,17 @@ std::string settings_yaml(const Settings& s) {
       "orb:\n  n_features: {}\n  scale_factor: {}\n  n_levels: {}\n  ini_th_fast: {}\n  min_th_fast: {}\n",
       s.orb.n_features, num(s.orb.scale_factor), s.orb.n_levels, s.orb.ini_th_fast, s.orb.min_th_fast);
 
-  // Keep the stage sections; drop the ones written above and ORB-SLAM's flat dotted keys (now in ours).
+  // Keep the stage sections; drop the ones written above, ORB-SLAM's flat dotted keys and its undotted spellings of
+  // ours (DepthMapFactor, ThDepth): written above in our spelling, they would be a second spelling of the key.
   if (s.root.IsMap()) {
     YAML::Emitter e;
     e << YAML::BeginMap;
     bool any = false;
     for (const auto& kv : s.root) {
       const std::string key = kv.first.as<std::string>();
-      if (key == "camera" || key == "depth" || key == "orb" || key.find('.') != std::string::npos) continue;
+      if (key == "camera" || key == "depth" || key == "orb" || key.find('.') != std::string::npos ||
+          spec_for_spelling(key))
+        continue;
       e << YAML::Key << key << YAML::Value << kv.second;
       any = true;
     }

@@ -36,11 +36,16 @@ struct Settings {
 
 /// Defaults: TUM fr1-like Kinect camera, 640x480, factor 5000.
 Settings default_settings();
+/// Parses settings text (`name` names it in errors): refuses text above 1 MiB, invalid YAML and a second YAML
+/// document, which would otherwise be ignored.
+YAML::Node parse_settings_yaml(const std::string& text, const std::string& name);
 /// Load a settings file; throws ConfigError naming the file and key on a missing or malformed value, and on any
-/// key the registry (core/setting_keys.hpp) does not declare.
+/// key the registry (core/setting_keys.hpp) does not declare; naming the file and the reason when it cannot be
+/// read (not found, a dangling symbolic link, a folder, no permission).
 Settings load_settings(const std::filesystem::path& file);
 /// The same from a parsed document (`file` names it in errors, `overrides` the keys set on the command line):
-/// re-reads camera, depth and ORB fields after `--set` overrides edited the document.
+/// re-reads camera, depth and ORB fields after `--set` overrides edited the document. A document that expands
+/// (through aliases) to more than 10000 values is refused before it is walked.
 Settings settings_from_yaml(const YAML::Node& root, const std::filesystem::path& file,
                             const std::map<std::string, std::string>& overrides = {});
 /// Our own YAML layout of `s` (what `synth` puts next to a generated sequence), and writing it to a file.

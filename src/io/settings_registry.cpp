@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <set>
 #include <sstream>
@@ -151,21 +152,26 @@ std::optional<Found> find_spelling(const YAML::Node& root, std::string_view dott
   return std::nullopt;
 }
 
+// Every place the document gives `k` a value, in each of its spellings (ours nested or flat, ORB-SLAM's).
+std::vector<Found> spellings_given(const YAML::Node& root, const KeySpec& k) {
+  std::vector<Found> found;
+  if (!root || !root.IsMap()) return found;
+  const auto add = [&](std::string_view spelled) {
+    if (auto n = walk(root, split(spelled, '.'), 0); n && !n->IsNull()) found.push_back({*n, std::string(spelled)});
+    if (spelled.find('.') == std::string_view::npos) return;  // "ThDepth": the walk found the same node
+    const YAML::Node flat = root[std::string(spelled)];
+    if (flat.IsDefined() && !flat.IsNull()) found.push_back({flat, std::string(spelled)});
+  };
+  add(k.name);
+  for (std::string_view alias : split(k.aliases, '|')) add(alias);
+  return found;
+}
+
 std::optional<Found> find_value(const YAML::Node& root, const KeySpec& k) {
   if (auto f = find_spelling(root, k.name)) return f;
   for (std::string_view alias : split(k.aliases, '|'))
     if (auto f = find_spelling(root, alias)) return f;
   return std::nullopt;
-}
-
-// The declaration a document key stands for: our own name or one of the aliases.
-const KeySpec* spec_for_spelling(std::string_view spelled) {
-  for (const KeySpec& k : setting_keys::all()) {
-    if (k.name == spelled) return &k;
-    for (std::string_view alias : split(k.aliases, '|'))
-      if (alias == spelled) return &k;
-  }
-  return nullptr;
 }
 
 bool is_ignored_foreign_key(std::string_view key) {
@@ -200,7 +206,31 @@ std::string suggestion(std::string_view name, bool section_only) {
   return near.empty() ? std::string(" (`varslam settings` lists every key)") : fmt::format(" (did you mean {}?)", near);
 }
 
+bool equal_ignoring_case(std::string_view a, std::string_view b) {
+  return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) {
+           return std::tolower(static_cast<unsigned char>(x)) == std::tolower(static_cast<unsigned char>(y));
+         });
+}
+
+// The declared spelling (section, key or ORB-SLAM alias) that `name` writes in another case; empty when none.
+// Names are case-sensitive, and "Tracking.kernel" would otherwise pass for an ignored ORB-SLAM "Tracking." key.
+std::string case_variant(std::string_view name) {
+  const auto other_case = [&](std::string_view declared) {
+    return declared != name && equal_ignoring_case(name, declared);
+  };
+  for (std::string_view sec : setting_keys::kSections)
+    if (other_case(sec)) return std::string(sec);
+  for (const KeySpec& k : setting_keys::all()) {
+    if (other_case(k.name)) return std::string(k.name);
+    for (std::string_view alias : split(k.aliases, '|'))
+      if (other_case(alias)) return std::string(alias);
+  }
+  return {};
+}
+
 [[noreturn]] void unknown(const std::string& loc, std::string_view what, std::string_view name, bool section) {
+  if (const std::string right = case_variant(name); !right.empty())
+    throw ConfigError(fmt::format("{}: unknown {} '{}': names are case-sensitive; write '{}'", loc, what, name, right));
   throw ConfigError(fmt::format("{}: unknown {} '{}'{}", loc, what, name, suggestion(name, section)));
 }
 
@@ -229,6 +259,19 @@ void check_unique_keys(const YAML::Node& map, const std::filesystem::path& file,
     if (auto [it, fresh] = seen.emplace(key, line); !fresh)
       throw ConfigError(fmt::format("{}: key '{}{}' appears twice (lines {} and {}); give it once",
                                     location(file, kv.first), prefix, key, it->second, line));
+  }
+}
+
+// Two spellings of one key ("camera.fx" and ORB-SLAM's "Camera1.fx", or "Camera.fx" beside "Camera1.fx"): only
+// one would be read and the other ignored, so the file must say which it means.
+void check_one_spelling_per_key(const YAML::Node& root, const std::filesystem::path& file) {
+  for (const KeySpec& k : setting_keys::all()) {
+    const std::vector<Found> found = spellings_given(root, k);
+    if (found.size() < 2) continue;
+    const auto line = [](const Found& f) { return f.node.Mark().line + 1; };
+    throw ConfigError(fmt::format("{}: '{}' (line {}) and '{}' (line {}) both give {}; give it once",
+                                  file.empty() ? std::string("<settings>") : file.string(), found[0].key,
+                                  line(found[0]), found[1].key, line(found[1]), k.name));
   }
 }
 
@@ -299,6 +342,15 @@ std::string number_text(double v) {
 
 }  // namespace
 
+const KeySpec* spec_for_spelling(std::string_view spelled) {
+  for (const KeySpec& k : setting_keys::all()) {
+    if (k.name == spelled) return &k;
+    for (std::string_view alias : split(k.aliases, '|'))
+      if (alias == spelled) return &k;
+  }
+  return nullptr;
+}
+
 const KeySpec& key_spec(std::string_view name) {
   if (const KeySpec* k = setting_keys::find(name)) return *k;
   throw std::logic_error(fmt::format("settings key '{}' is not declared in core/setting_keys.hpp", name));
@@ -349,6 +401,7 @@ void check_settings_document(const YAML::Node& root, const std::filesystem::path
       if (!value.IsNull()) check_value(*k, value, where(file, overrides, kv.first, top));
       continue;
     }
+    if (!case_variant(top).empty()) unknown(location(file, kv.first), "key", top, false);
     if (is_ignored_foreign_key(top)) continue;
     if (top == "Camera.type" || top == "Camera.imageScale") {  // ORB-SLAM keys whose other values we cannot honour
       check_supported_camera(top, value, location(file, kv.first));
@@ -375,6 +428,7 @@ void check_settings_document(const YAML::Node& root, const std::filesystem::path
       if (!entry.second.IsNull()) check_value(*k, entry.second, loc);
     }
   }
+  check_one_spelling_per_key(root, file);
 }
 
 void apply_setting_overrides(Settings& settings, const std::vector<std::string>& overrides) {
@@ -392,6 +446,7 @@ void apply_setting_overrides(Settings& settings, const std::vector<std::string>&
     const std::string dotted = o.substr(0, eq), value = o.substr(eq + 1);
     const KeySpec* k = setting_keys::find(dotted);
     if (!k) {
+      if (!case_variant(dotted).empty()) unknown(loc, "key", dotted, false);
       const auto [section, key] = section_and_key(dotted);
       if (!is_section(section)) unknown(loc, "section", section, true);
       unknown(loc, "key", dotted, false);
@@ -408,8 +463,10 @@ void apply_setting_overrides(Settings& settings, const std::vector<std::string>&
     YAML::Node sec = settings.root[std::string(section)];
     if (sec && !sec.IsMap() && !sec.IsNull())
       throw ConfigError(fmt::format("{}: settings key '{}' is not a section", loc, section));
+    // The override replaces the key in whatever spelling the file gave it, rather than standing beside it.
+    settings.root.remove(dotted);
+    for (std::string_view alias : split(k->aliases, '|')) settings.root.remove(std::string(alias));
     settings.root[std::string(section)][std::string(key)] = parsed;
-    // A flat ORB-SLAM spelling of the same key would be read after ours anyway; ours wins.
     settings.overrides[dotted] = loc;
   }
   // Camera, depth and ORB fields were read when the document was loaded: read them again from the edited one.
@@ -419,9 +476,14 @@ void apply_setting_overrides(Settings& settings, const std::vector<std::string>&
 }
 
 std::string nearest_key(std::string_view name, bool section_only) {
+  // Close enough to be a typo: a third of the name, at least 2 edits (a section typo inside a full key included).
+  const std::size_t allowed = std::max<std::size_t>(2, name.size() / 3);
   std::string best;
   std::size_t best_d = SIZE_MAX;
   const auto consider = [&](std::string_view candidate) {
+    // The distance is at least the difference in length: a candidate that far off cannot be the answer.
+    const std::size_t length_gap = std::max(name.size(), candidate.size()) - std::min(name.size(), candidate.size());
+    if (length_gap > allowed) return;
     const std::size_t d = edit_distance(name, candidate);
     if (d < best_d) {
       best_d = d;
@@ -433,8 +495,6 @@ std::string nearest_key(std::string_view name, bool section_only) {
   } else {
     for (const KeySpec& k : setting_keys::all()) consider(k.name);
   }
-  // Close enough to be a typo: a third of the name, at least 2 edits (a section typo inside a full key included).
-  const std::size_t allowed = std::max<std::size_t>(2, name.size() / 3);
   return best_d <= allowed ? best : std::string();
 }
 
@@ -499,8 +559,11 @@ std::string settings_reference_markdown() {
          "a test keeps this file up to date.\n\n"
          "A settings file is YAML: a map per section (`tracking: {kernel: huber}`), or ORB-SLAM3's flat keys "
          "(`Camera1.fx: 535.4`). Any key can be overridden on the command line: `--set tracking.kernel=huber`. "
-         "An unknown section or key, a key given twice, a value of the wrong type, NaN or a value outside its "
-         "range is an error that names the file and line (or the `--set`) and the nearest valid key.\n";
+         "An unknown section or key, a key given twice (also in two spellings, such as `camera.fx` and "
+         "`Camera1.fx`), a name in another case (`Tracking.Kernel`), a value of the wrong type, NaN or a value "
+         "outside its range is an error that names the file and line (or the `--set`) and the nearest valid key. "
+         "A settings file is one YAML document of at most 1 MiB that expands, through its aliases, to at most "
+         "10000 values.\n";
   std::string_view section;
   for (const KeySpec& k : setting_keys::all()) {
     const auto [sec, key] = section_and_key(k.name);

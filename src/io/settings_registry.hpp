@@ -16,6 +16,10 @@ namespace varslam {
 /// The declared key `name`; throws std::logic_error for an undeclared one (a programming error, not user input).
 const setting_keys::KeySpec& key_spec(std::string_view name);
 
+/// The declared key a document spelling stands for: our own name or an ORB-SLAM alias ("Camera1.fx",
+/// "DepthMapFactor"); nullptr when it is neither.
+const setting_keys::KeySpec* spec_for_spelling(std::string_view spelled);
+
 /// The value of a declared key: from the document (or an override) when given, else the registry's default.
 /// T: int, double, bool, std::string (Choice / Text / Path), std::vector<std::string>, std::map<string, string>.
 /// A wrong type or a value outside the key's range is a ConfigError naming the source (file:line or --set).

@@ -137,6 +137,19 @@ std::vector<OutputFile> run_outputs(const RunOptions& options) {
   return out;
 }
 
+// Debug frames the run does not reach would draw nothing and say nothing: refuse them before the run.
+void check_debug_frames(const std::set<std::size_t>& frames, std::size_t first, std::size_t count,
+                        const Dataset& dataset) {
+  std::vector<std::size_t> outside;
+  for (const std::size_t f : frames)
+    if (f < first || f - first >= count) outside.push_back(f);
+  if (outside.empty()) return;
+  throw InputError(fmt::format("--debug-frames {}: outside the frames this run processes, {} to {} of the {} in {} "
+                               "(see --first and --max-frames)",
+                               fmt::join(outside, ","), first, first + count - 1, dataset.size(),
+                               dataset.root().string()));
+}
+
 }  // namespace
 
 void write_map_ply(const slam::Map& map, const std::filesystem::path& file) {
@@ -155,6 +168,7 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const RunO
   const std::size_t first = std::min(options.first, dataset.size());
   const std::size_t count = std::min(options.max_frames, dataset.size() - first);
   if (count == 0) throw InputError(fmt::format("{}: no frames to process", dataset.root().string()));
+  check_debug_frames(options.debug_frames, first, count, dataset);
   // Checked before the run, so a broken file does not cost one.
   const auto gt_path = options.groundtruth ? options.groundtruth : dataset.groundtruth();
   std::optional<Trajectory> groundtruth;

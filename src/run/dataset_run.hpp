@@ -22,7 +22,8 @@ struct RunOptions {
   std::size_t max_frames = SIZE_MAX;
   bool progress = true;        // progress line on stderr
   std::optional<std::filesystem::path> groundtruth;  // overrides the dataset's groundtruth.txt
-  std::set<std::size_t> debug_frames;  // frame indices for which the semantic filter's stages are drawn
+  // Frame indices for which the semantic filter's stages are drawn; one outside the run's frames is an InputError.
+  std::set<std::size_t> debug_frames;
   std::vector<Observer*> observers;    // more observers of the pipeline (e.g. a live viewer)
   // A run tracking a smaller share of its frames failed (RunSummary::failure says why); 0 accepts any run.
   double min_tracked_share = 0.5;

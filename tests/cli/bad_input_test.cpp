@@ -82,6 +82,17 @@ std::string run_on(const fs::path& seq, const std::string& name, const std::stri
   return "run -q -d " + seq.string() + " -o " + out_dir(name).string() + " " + extra;
 }
 
+// "Billion laughs": ten levels of ten aliases each, 10^10 values to a walk over the tree.
+std::string alias_bomb() {
+  std::string yaml = "x0: &x0 [a, a, a, a, a, a, a, a, a, a]\n";
+  for (int i = 1; i < 10; ++i) {
+    yaml += "x" + std::to_string(i) + ": &x" + std::to_string(i) + " [";
+    for (int j = 0; j < 10; ++j) yaml += (j ? ", *x" : "*x") + std::to_string(i - 1);
+    yaml += "]\n";
+  }
+  return yaml;
+}
+
 struct SettingsCase {
   std::string name, set_args, appended_yaml, expect;
 };
@@ -121,8 +132,62 @@ INSTANTIATE_TEST_SUITE_P(
         SettingsCase{"set_negative_count", "--set tracking.close_keyframe_gap=-5", "", "[1, 1000000]"},
         SettingsCase{"set_huge_cx", "--set camera.cx=1e300", "", "camera.cx"},
         SettingsCase{"set_broken_yaml", "'--set' 'camera.fx=[1, 2'", "", "not valid YAML"},
-        SettingsCase{"set_n_levels", "--set orb.n_levels=1000", "", "[1, 32]"}),
+        SettingsCase{"set_n_levels", "--set orb.n_levels=1000", "", "[1, 32]"},
+        // Settings that were silently ignored: a second spelling of a key, another case, a second document.
+        SettingsCase{"yaml_orbslam_fx_beside_ours", "", "Camera1.fx: 600\n", "both give camera.fx"},
+        SettingsCase{"yaml_orbslam_depth_factor", "", "RGBD.DepthMapFactor: 1000\n", "both give depth.factor"},
+        SettingsCase{"yaml_other_case", "", "Tracking.Kernel: huber\n", "write 'tracking.kernel'"},
+        SettingsCase{"yaml_second_document", "", "---\ncamera:\n  fx: 600\n", "a second YAML document"},
+        SettingsCase{"yaml_alias_bomb", "", alias_bomb(), "expands to more than 10000 values"}),
     [](const auto& param_info) { return param_info.param.name; });
+
+// A settings file that is there but cannot be read, in the dataset folder or given: an error saying why, never a
+// run with the default camera and a warning that there is no settings file.
+TEST(BadInput, ASettingsFileThatCannotBeReadIsAnErrorSayingWhy) {
+  const fs::path seq = copy_of_base("dangling_settings");
+  fs::remove(seq / "settings.yaml");
+  fs::create_symlink(seq / "moved.yaml", seq / "settings.yaml");
+  const Outcome link = cli(run_on(seq, "dangling_settings"));
+  EXPECT_EQ(link.exit_code, 2) << link.output;
+  EXPECT_THAT(link.output, AllOf(HasSubstr("settings.yaml: the settings file is a symbolic link to"),
+                                 HasSubstr("moved.yaml, which does not exist")));
+  EXPECT_THAT(link.output, ::testing::Not(HasSubstr("default settings")));
+  const Outcome given = cli(run_on(base_sequence(), "dangling_given", "--settings " + (seq / "settings.yaml").string()));
+  EXPECT_EQ(given.exit_code, 2) << given.output;
+  EXPECT_THAT(given.output, HasSubstr("which does not exist"));
+  fs::remove(seq / "settings.yaml");
+  fs::create_directories(seq / "settings.yaml");
+  const Outcome folder = cli(run_on(seq, "folder_settings"));
+  EXPECT_EQ(folder.exit_code, 2) << folder.output;
+  EXPECT_THAT(folder.output, HasSubstr("settings.yaml: is a folder, not a settings file"));
+}
+
+// Options that only work beside another were ignored alone; debug frames past the run drew nothing. All are errors
+// naming both options (or the frames and the run's range) before any work.
+TEST(BadInput, AnOptionWithoutTheOneItNeedsIsAnErrorNamingBoth) {
+  const std::string seq = base_sequence().string();
+  const std::string gt = seq + "/groundtruth.txt";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {run_on(base_sequence(), "pace_alone", "--pace"), "--pace feeds frames at the dataset's rate in real-time "
+                                                        "mode: it only works with --realtime, which is not given"},
+      {run_on(base_sequence(), "port_alone", "--viewer-port 8123"), "--viewer-port"},
+      {run_on(base_sequence(), "hold_alone", "--viewer-hold"), "--viewer-hold"},
+      {"eval --gt " + gt + " --est " + gt + " --per-pair", "--per-pair"},
+      {"bench --peer-name other --out " + out_dir("peer_alone").string(), "--peer-name"}};
+  for (const auto& [args, flag] : cases) {
+    const Outcome o = cli(args);
+    EXPECT_EQ(o.exit_code, 2) << args << "\n" << o.output;
+    EXPECT_THAT(o.output, AllOf(HasSubstr(flag), HasSubstr("it only works with"))) << args;
+  }
+  const Outcome beyond = cli(run_on(base_sequence(), "debug_beyond", "-n 5 --debug-frames 2,50,900"));
+  EXPECT_EQ(beyond.exit_code, 2) << beyond.output;
+  EXPECT_THAT(beyond.output, AllOf(HasSubstr("--debug-frames 50,900: outside the frames this run processes, 0 to 4 "
+                                             "of the"),
+                                   HasSubstr(base_sequence().string())));
+  EXPECT_FALSE(fs::exists(out_path("debug_beyond") / "CameraTrajectory.txt")) << "the run should not have started";
+  const Outcome inside = cli(run_on(base_sequence(), "debug_inside", "-n 5 --debug-frames 2"));
+  EXPECT_EQ(inside.exit_code, 0) << inside.output;
+}
 
 TEST(BadInput, AllZeroDepthIsAFailedRunThatSaysWhy) {
   const fs::path seq = copy_of_base("zero_depth");

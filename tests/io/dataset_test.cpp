@@ -332,6 +332,11 @@ TEST(Dataset, SettingsForDatasetPrefersExplicitThenFolderThenDefaults) {
   save_settings(other, dir / "other.yaml");
   EXPECT_DOUBLE_EQ(settings_for_dataset(dir.path(), dir / "other.yaml").camera.fx, 700);
   EXPECT_THROW(settings_for_dataset(dir.path(), dir / "missing.yaml"), ConfigError);
+
+  // A settings.yaml that is there but cannot be read is an error, not the default camera.
+  std::filesystem::remove(dir / "settings.yaml");
+  std::filesystem::create_symlink(dir / "moved.yaml", dir / "settings.yaml");
+  EXPECT_THROW(settings_for_dataset(dir.path(), std::nullopt), ConfigError);
 }
 
 // ---- prefetcher ----

@@ -68,6 +68,40 @@ TEST(SettingsRegistry, KeyGivenTwiceIsAnError) {
   EXPECT_THAT(load_error("tracking: {kernel: huber, kernel: none}\n"), HasSubstr("'tracking.kernel' appears twice"));
 }
 
+// Only one spelling of a key is read; the other was ignored without a word.
+TEST(SettingsRegistry, TwoSpellingsOfOneKeyAreAnErrorNamingBoth) {
+  EXPECT_THAT(load_error("Camera1.fx: 600\n"),
+              AllOf(HasSubstr("s.yaml: 'camera.fx' (line 1) and 'Camera1.fx' (line 3) both give camera.fx"),
+                    HasSubstr("give it once")));
+  EXPECT_THAT(load_error("RGBD.DepthMapFactor: 1000\n"),
+              HasSubstr("'depth.factor' (line 2) and 'RGBD.DepthMapFactor' (line 3) both give depth.factor"));
+  EXPECT_THAT(load_error("tracking.kernel: huber\ntracking: {kernel: none}\n"), HasSubstr("both give tracking.kernel"));
+  TempDir dir;
+  const std::string orb = "Camera1.fx: 500\nCamera1.fy: 500\nCamera1.cx: 320\nCamera1.cy: 240\n";
+  EXPECT_THAT(config_error([&] { load_settings(dir.write("orb.yaml", orb + "Camera.fx: 600\n")); }),
+              HasSubstr("'Camera1.fx' (line 1) and 'Camera.fx' (line 5) both give camera.fx"));
+  // One spelling per key reads as before, and an override replaces the file's spelling instead of joining it.
+  Settings s = load_settings(dir.write("one.yaml", orb + "RGBD.DepthMapFactor: 1000\n"));
+  EXPECT_DOUBLE_EQ(s.depth_factor, 1000.0);
+  apply_setting_overrides(s, {"camera.fx=600", "depth.factor=5000"});
+  EXPECT_DOUBLE_EQ(s.camera.fx, 600.0);
+  EXPECT_DOUBLE_EQ(s.depth_factor, 5000.0);
+}
+
+// Names are case-sensitive: "Tracking.Kernel" passed as an ignored ORB-SLAM "Tracking." key.
+TEST(SettingsRegistry, ANameInAnotherCaseIsAnErrorGivingTheRightSpelling) {
+  EXPECT_THAT(load_error("Tracking.Kernel: huber\n"),
+              AllOf(HasSubstr("s.yaml:3:"), HasSubstr("'Tracking.Kernel': names are case-sensitive; write "
+                                                      "'tracking.kernel'")));
+  EXPECT_THAT(load_error("Tracking: {kernel: huber}\n"), HasSubstr("write 'tracking'"));
+  EXPECT_THAT(load_error("tracking: {Kernel: huber}\n"), HasSubstr("write 'tracking.kernel'"));
+  EXPECT_THAT(load_error("camera1.FX: 500\n"), HasSubstr("write 'Camera1.fx'"));
+  EXPECT_NO_THROW(load_settings(TempDir().write("s.yaml", kCamera + "Tracking.Other: 1\n")));  // ORB-SLAM's own
+  Settings s = default_settings();
+  EXPECT_THAT(config_error([&] { apply_setting_overrides(s, {"Tracking.Kernel=huber"}); }),
+              AllOf(HasSubstr("--set 'Tracking.Kernel=huber'"), HasSubstr("write 'tracking.kernel'")));
+}
+
 TEST(SettingsRegistry, NanOutOfRangeAndNegativeCountsAreErrors) {
   EXPECT_THAT(load_error("tracking: {barron_alpha: .nan}\n"),
               AllOf(HasSubstr("tracking.barron_alpha"), HasSubstr("finite")));
