@@ -674,7 +674,7 @@ bool Tracker::track_local_map(Frame& cur, FrameTimings& t) {
   match_local_map(cur, local_points_, recently_recovered ? 2.0 : 1.0);
   t.match_ms += ms_since(t0);
   optimize_and_discard(cur, t);
-  int inliers = 0;
+  int inliers = 0, odometry_inliers = 0;
   for (std::size_t i = 0; i < cur.map_points.size(); ++i) {
     const MapPointPtr& mp = cur.map_points[i];
     if (!mp) continue;
@@ -684,9 +684,13 @@ bool Tracker::track_local_map(Frame& cur, FrameTimings& t) {
     }
     mp->increase_found();
     if (mp->num_observations() > 0) ++inliers;
+    else ++odometry_inliers;
   }
-  const int needed = recently_recovered ? 50 : cfg_.tracking.min_inliers_local_map;
-  return inliers >= needed;
+  if (recently_recovered) return inliers >= 50;
+  // Localization only: where the map thins out (a view it was not built from), the last frame's depth points carry
+  // the pose as visual odometry until the map is in view again.
+  if (localization_only_) return inliers + odometry_inliers >= cfg_.tracking.min_inliers_local_map;
+  return inliers >= cfg_.tracking.min_inliers_local_map;
 }
 
 void Tracker::clean_temporary_matches(Frame& cur) {
