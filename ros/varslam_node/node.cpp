@@ -86,6 +86,7 @@ VarslamNode::VarslamNode(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh), pnh
   alpha_pub_ = pnh_.advertise<std_msgs::Float64>("local_ba_alpha", 10);
   people_pub_ = pnh_.advertise<visualization_msgs::MarkerArray>("person_boxes", 10);
   people_sub_ = nh_.subscribe("people", 100, &VarslamNode::on_people, this);
+  initial_pose_sub_ = nh_.subscribe("initialpose", 1, &VarslamNode::on_initial_pose, this);
   save_srv_ = pnh_.advertiseService("save_map", &VarslamNode::save_map, this);
   load_srv_ = pnh_.advertiseService("load_map", &VarslamNode::load_map, this);
   reset_srv_ = pnh_.advertiseService("reset", &VarslamNode::reset, this);
@@ -249,6 +250,8 @@ void VarslamNode::ensure_session(const sensor_msgs::Image& rgb) {
   if (params_.camera_frame.front() == '/') params_.camera_frame.erase(0, 1);  // tf2 frame ids have no leading '/'
   if (params_.load_map_at_start) slam_->load_map(params_.map_file);
   if (params_.localization_only) slam_->set_localization_only(true);
+  if (pending_hint_) slam_->relocalize_near(pending_hint_->first, pending_hint_->second);
+  pending_hint_.reset();
 }
 
 void VarslamNode::track(const Pending& p) {
@@ -451,6 +454,31 @@ bool VarslamNode::reset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response
   res.success = true;
   res.message = "session reset";
   return true;
+}
+
+void VarslamNode::on_initial_pose(const geometry_msgs::PoseWithCovarianceStampedConstPtr& msg) {
+  const std::string& frame = msg->header.frame_id;
+  if (!frame.empty() && frame != params_.map_frame && frame != "/" + params_.map_frame) {
+    ROS_WARN("initialpose in frame '%s' ignored: give the camera's pose in ~map_frame '%s'", frame.c_str(),
+             params_.map_frame.c_str());
+    return;
+  }
+  const auto& p = msg->pose.pose;
+  varslam::Pose pose;
+  pose.translation = {p.position.x, p.position.y, p.position.z};
+  pose.rotation = {p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w};
+  // Three standard deviations of the position, at least 0.3 m; RViz's 2D Pose Estimate gives 0.5 m in x and y.
+  const auto& c = msg->pose.covariance;
+  const double radius = std::max(0.3, 3 * std::sqrt(std::max({c[0], c[7], c[14], 0.0})));
+  const auto lock = lock_for_service();
+  try {
+    if (slam_) slam_->relocalize_near(pose, radius);
+    else pending_hint_ = std::make_pair(pose, radius);
+    ROS_INFO("relocalization hint: (%.2f, %.2f, %.2f) in %s, within %.2f m, used while tracking is lost", p.position.x,
+             p.position.y, p.position.z, params_.map_frame.c_str(), radius);
+  } catch (const varslam::InputError& e) {
+    ROS_WARN("initialpose ignored: %s", e.what());
+  }
 }
 
 bool VarslamNode::localization_only(std_srvs::SetBool::Request& req, std_srvs::SetBool::Response& res) {

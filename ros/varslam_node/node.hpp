@@ -3,6 +3,7 @@
 // odometry, TF, paths, map points, keyframes, tracking state and Local BA alpha out; services to save and load the
 // map, switch localization-only and reset. No SLAM logic here.
 #include <geometry_msgs/PolygonStamped.h>
+#include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <message_filters/subscriber.h>
 #include <message_filters/sync_policies/approximate_time.h>
@@ -52,6 +53,8 @@ class VarslamNode : public varslam::Listener {
   void on_images(const sensor_msgs::ImageConstPtr& rgb, const sensor_msgs::ImageConstPtr& depth);
   void on_camera_info(const sensor_msgs::CameraInfoConstPtr& info);
   void on_people(const geometry_msgs::PolygonStampedConstPtr& people);
+  /// `initialpose` (RViz's "2D Pose Estimate"): the camera's pose in ~map_frame, a relocalization hint.
+  void on_initial_pose(const geometry_msgs::PoseWithCovarianceStampedConstPtr& pose);
   /// The person boxes given for this image stamp on `people` (waiting briefly when a publisher exists), if any.
   std::optional<std::vector<varslam::PersonBox>> people_for(const ros::Time& stamp);
   void on_person_boxes(const varslam::PersonBoxesInfo& info) override;
@@ -81,7 +84,7 @@ class VarslamNode : public varslam::Listener {
 
   message_filters::Subscriber<sensor_msgs::Image> rgb_sub_, depth_sub_;
   std::unique_ptr<message_filters::Synchronizer<SyncPolicy>> sync_;
-  ros::Subscriber info_sub_, colour_count_sub_, people_sub_;
+  ros::Subscriber info_sub_, colour_count_sub_, people_sub_, initial_pose_sub_;
   ros::Publisher odom_pub_, tf_pub_, path_pub_, corrected_path_pub_, points_pub_, keyframes_pub_, state_pub_,
       alpha_pub_, people_pub_;
   ros::ServiceServer save_srv_, load_srv_, reset_srv_, loc_srv_;
@@ -98,6 +101,8 @@ class VarslamNode : public varslam::Listener {
   std::mutex session_mutex_;              // held by the tracking thread for each frame, and by the services
   std::atomic<int> services_waiting_{0};  // the tracking thread lets a waiting service in before its next frame
   std::unique_lock<std::mutex> lock_for_service();
+  // A hint that came before the session started (under session_mutex_): given to it when it starts.
+  std::optional<std::pair<varslam::Pose, double>> pending_hint_;
 
   // Owned by the tracking thread (stats_ also read by write_stats after it stopped).
   nav_msgs::Path live_path_;

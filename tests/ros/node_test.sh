@@ -66,7 +66,9 @@ for _ in $(seq 100); do
   rosservice list 2>/dev/null | grep -q /varslam/save_map && rostopic info /varslam/odometry 2>/dev/null | grep -q record && break
   sleep 0.2
 done
-rosbag play -q "$work/seq.bag" > "$work/play.log" 2>&1 &
+# -d 1: a second for the node to connect after each topic is advertised (the default 0.2 s lost the first frame
+# on a loaded machine)
+rosbag play -q -d 1 "$work/seq.bag" > "$work/play.log" 2>&1 &
 play=$!
 # The live viewer from the node: a client on its event stream makes it encode frames while the bag plays.
 for _ in $(seq 50); do grep -q 'viewer: open http' "$work/node.log" && break; sleep 0.1; done
@@ -85,6 +87,12 @@ rosservice call /varslam/reset > "$work/reset.log" 2>&1 || fail "reset service"
 grep -q "success: True" "$work/reset.log" || fail "reset refused"
 rosservice call /varslam/load_map > "$work/load.log" 2>&1 || fail "load_map service"
 grep -q "success: True" "$work/load.log" || fail "load_map refused: $(cat "$work/load.log")"
+# A relocalization hint on initialpose (RViz's 2D Pose Estimate) reaches the session; one in another frame is refused.
+rostopic pub -1 /initialpose geometry_msgs/PoseWithCovarianceStamped \
+  "{header: {frame_id: map}, pose: {pose: {position: {x: 0.1, y: 0, z: 0}, orientation: {w: 1}}}}" > /dev/null 2>&1 \
+  || fail "rostopic pub initialpose"
+rostopic pub -1 /initialpose geometry_msgs/PoseWithCovarianceStamped \
+  "{header: {frame_id: base_link}, pose: {pose: {orientation: {w: 1}}}}" > /dev/null 2>&1 || fail "rostopic pub initialpose"
 
 # rosbag record is a wrapper: its recorder child closes the bag on SIGINT.
 pkill -INT -P "$rec" || true
@@ -93,6 +101,10 @@ wait "$rec" || true
 for _ in $(seq 50); do [[ -f $work/out.bag ]] && break; sleep 0.1; done
 [[ -f $work/out.bag ]] || fail "rosbag record left no bag: $(ls "$work" | tr "\n" " ")"
 kill -INT "$node"; wait "$node" || fail "roslaunch and the node did not stop cleanly"
+# (checked once the node stopped: its standard output is flushed then)
+grep -q "relocalization hint: (0.10, 0.00, 0.00) in map, within 0.30 m" "$work/node.log" \
+  || fail "the node did not take the initialpose hint"
+grep -q "initialpose in frame 'base_link' ignored" "$work/node.log" || fail "an initialpose in another frame was not refused"
 for _ in $(seq 100); do [[ -s $work/stats.json ]] && break; sleep 0.1; done
 [[ -s $work/stats.json ]] || fail "no stats file"
 
@@ -138,7 +150,7 @@ for _ in $(seq 100); do
   rostopic info /tf 2>/dev/null | grep -q varslam_odom && rostopic info /tf 2>/dev/null | grep -q record && break
   sleep 0.2
 done
-rosbag play -q -u 2 "$work/seq.bag" > /dev/null 2>&1
+rosbag play -q -d 1 -u 2 "$work/seq.bag" > /dev/null 2>&1
 sleep 2
 pkill -INT -P "$rec" || true; kill -INT "$rec" 2>/dev/null || true; wait "$rec" || true
 kill -INT "$node"; wait "$node" || fail "the odom node did not stop cleanly"
