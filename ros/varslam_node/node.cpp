@@ -48,8 +48,9 @@ const char* state_name(varslam::TrackingState s) {
   return "unknown";
 }
 
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0;
+double percentile(const std::deque<double>& window, double q) {
+  if (window.empty()) return 0;
+  std::vector<double> v(window.begin(), window.end());
   const auto k = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5);
   std::nth_element(v.begin(), v.begin() + static_cast<long>(k), v.end());
   return v[k];
@@ -266,6 +267,7 @@ void VarslamNode::track(const Pending& p) {
     if (people) ++stats_.with_people;
     publish_pose(f, p.rgb->header);
     stats_.latency_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - p.received).count());
+    if (stats_.latency_ms.size() > Stats::kLatencyWindow) stats_.latency_ms.pop_front();
     if (f.pose)
       ++stats_.tracked;
     else

@@ -109,7 +109,9 @@ class VarslamNode : public varslam::Listener {
   std::size_t keyframes_since_map_ = 0;
   struct Stats {
     std::size_t synced = 0, tracked = 0, lost = 0, rejected = 0, max_queue = 0, with_people = 0;
-    std::vector<double> latency_ms;  // receipt of the pair to the published pose
+    // Receipt of the pair to the published pose, the last kLatencyWindow frames (a node runs for days).
+    static constexpr std::size_t kLatencyWindow = 100000;
+    std::deque<double> latency_ms;
   } stats_;
   std::atomic<std::size_t> colour_seen_{0};
   // Person boxes by image stamp, from `people` (geometry_msgs/PolygonStamped: two corners per box, z = score).
