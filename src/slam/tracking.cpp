@@ -555,11 +555,7 @@ bool Tracker::relocalize(Frame& cur, FrameTimings& t) {
   for (const auto& cand : candidates) {
     if (tried.contains(cand.keyframe->id())) continue;
     int inliers = locate_against_keyframe(cur, *cand.keyframe, lc);
-    if (inliers == 0 && in_foreign_map) {
-      const KeyframeNeighbourhood near = keyframe_neighbourhood(*cand.keyframe, rc.neighbourhood_keyframes);
-      tried.insert(near.keyframe_ids.begin(), near.keyframe_ids.end());
-      inliers = locate_against_points(cur, near.points, static_cast<std::uint64_t>(cand.keyframe->id()) + 1, wide);
-    }
+    if (inliers == 0 && in_foreign_map) inliers = locate_in_neighbourhood(cur, *cand.keyframe, wide, tried);
     if (inliers == 0) continue;
     t.match_ms += ms_since(t0);
     accept_relocalization(cur, cand.keyframe, inliers, cand.score);
@@ -569,6 +565,13 @@ bool Tracker::relocalize(Frame& cur, FrameTimings& t) {
   }
   t.match_ms += ms_since(t0);
   return false;
+}
+
+int Tracker::locate_in_neighbourhood(Frame& cur, const KeyFrame& kf, const LocalizationConfig& lc,
+                                     std::unordered_set<long>& tried) const {
+  const KeyframeNeighbourhood near = keyframe_neighbourhood(kf, cfg_.relocalization.neighbourhood_keyframes);
+  tried.insert(near.keyframe_ids.begin(), near.keyframe_ids.end());
+  return locate_against_points(cur, near.points, static_cast<std::uint64_t>(kf.id()) + 1, lc);
 }
 
 void Tracker::accept_relocalization(Frame& cur, const KeyFramePtr& kf, int inliers, int score) {
@@ -583,23 +586,25 @@ bool Tracker::relocalize_near_hint(Frame& cur) {
   const Eigen::Vector3d centre = pose_hint_->T_wc.translation();
   const double radius = pose_hint_->radius_m;
   std::vector<std::pair<double, KeyFramePtr>> near;  // by distance, then id (keyframes() is ordered by id)
-  for (const auto& kf : map_.keyframes())
-    if (!kf->is_bad() && (kf->camera_center() - centre).norm() <= radius)
-      near.emplace_back((kf->camera_center() - centre).norm(), kf);
+  for (const auto& kf : map_.keyframes()) {
+    const double distance = (kf->camera_center() - centre).norm();
+    if (!kf->is_bad() && distance <= radius) near.emplace_back(distance, kf);
+  }
   std::stable_sort(near.begin(), near.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   LocalizationConfig lc;
   lc.min_inliers = cfg_.relocalization.loaded_map_min_inliers;
   lc.kernel = cfg_.tracking.kernel;
   lc.ransac_iterations = kNeighbourhoodRansacIterations;
   std::unordered_set<long> tried;
+  const Eigen::Isometry3d prior = cur.T_cw;
   for (const auto& [distance, kf] : near) {
     if (tried.contains(kf->id())) continue;
-    const KeyframeNeighbourhood hood = keyframe_neighbourhood(*kf, cfg_.relocalization.neighbourhood_keyframes);
-    tried.insert(hood.keyframe_ids.begin(), hood.keyframe_ids.end());
-    const int inliers = locate_against_points(cur, hood.points, static_cast<std::uint64_t>(kf->id()) + 1, lc);
+    const int inliers = locate_in_neighbourhood(cur, *kf, lc, tried);
     if (inliers == 0) continue;
     if ((cur.T_cw.inverse().translation() - centre).norm() > radius) {  // a fix elsewhere: not where we were told
       std::fill(cur.map_points.begin(), cur.map_points.end(), nullptr);
+      std::fill(cur.outlier.begin(), cur.outlier.end(), false);
+      cur.T_cw = prior;
       continue;
     }
     accept_relocalization(cur, kf, inliers, 0);

@@ -4,6 +4,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <unordered_set>
 #include <vector>
 
 #include "core/rgbd_frame.hpp"
@@ -12,6 +13,7 @@
 #include "slam/frame.hpp"
 #include "slam/keyframe.hpp"
 #include "slam/keyframe_database.hpp"
+#include "slam/keyframe_localization.hpp"
 #include "slam/map.hpp"
 
 namespace varslam::slam {
@@ -124,6 +126,9 @@ class Tracker {
   /// Global relocalization: place candidates from the database, each located by descriptor matches + RANSAC.
   bool relocalize(Frame& cur, FrameTimings& t);
   bool relocalize_near_hint(Frame& cur);
+  /// locate_against_points() on `kf` and its best covisibles; adds their ids to `tried` (matched once per frame).
+  int locate_in_neighbourhood(Frame& cur, const KeyFrame& kf, const LocalizationConfig& lc,
+                              std::unordered_set<long>& tried) const;
   void accept_relocalization(Frame& cur, const KeyFramePtr& kf, int inliers, int score);
   bool track_local_map(Frame& cur, FrameTimings& t);
   int optimize_and_discard(Frame& cur, FrameTimings& t);
