@@ -43,7 +43,11 @@ print(f"{name} start {first}: {m['tracked_frames']}/{n} localized ({100*m['track
 PY
 }
 
-build_map fwd 0 600; [[ -n "${ONLY:-}" ]] && { for s in $ONLY; do session ${s%:*} ${s#*:} 200; done; exit 0; }
-for s in 600 700 800 900; do session fwd "$s" $((1000 - s)); done
+# Forward: map of 0-599, sessions to the end of the sequence. Reverse: map of 600-999, sessions of 200 frames.
+frames_of() {  # map first
+  if [[ $1 == fwd ]]; then echo $((1000 - $2)); else echo 200; fi
+}
+build_map fwd 0 600
 build_map rev 600 400
-for s in 0 200 400; do session rev "$s" 200; done
+sessions=${ONLY:-"fwd:600 fwd:700 fwd:800 fwd:900 rev:0 rev:200 rev:400"}
+for s in $sessions; do session "${s%:*}" "${s#*:}" "$(frames_of "${s%:*}" "${s#*:}")"; done
