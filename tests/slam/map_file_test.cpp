@@ -73,6 +73,18 @@ const fs::path& saved_map() {
   return file;
 }
 
+fs::path kitchen_folder() { return fs::path(VARSLAM_SHARED_DIR) / "realdata" / "7scenes_redkitchen"; }
+
+// A fresh `out` holding the run of the kitchen's first `frames` frames (out/a) and its map (out/k.map).
+void map_of_kitchen(const fs::path& out, std::size_t frames) {
+  fs::remove_all(out);
+  run::RunOptions mapping;
+  mapping.progress = false;
+  mapping.max_frames = frames;
+  mapping.save_map = out / "k.map";
+  e2e::run_with(kitchen_folder(), out / "a", mapping, {"semantic.detector=none"});
+}
+
 std::string decode_error(const std::string& bytes) {
   try {
     decode_map(bytes, "test.map");
@@ -252,15 +264,10 @@ namespace {
 // The real kitchen's depth is not registered to colour: each session estimates the colour camera from its own
 // frames, and two estimates differ by about 1 %. A session on a loaded map uses the map's camera instead.
 TEST(MapFile, ALoadedMapBringsItsColourCamera) {
-  const fs::path kitchen = fs::path(VARSLAM_SHARED_DIR) / "realdata" / "7scenes_redkitchen";
+  const fs::path kitchen = kitchen_folder();
   if (!fs::exists(kitchen / "rgb.txt")) GTEST_SKIP() << "no " << kitchen;
   const fs::path out = fs::temp_directory_path() / ("varslam_map_camera_" + std::to_string(::getpid()));
-  fs::remove_all(out);
-  run::RunOptions first;
-  first.progress = false;
-  first.max_frames = 120;
-  first.save_map = out / "k.map";
-  e2e::run_with(kitchen, out / "a", first, {"semantic.detector=none"});
+  map_of_kitchen(out, 120);
   const nlohmann::json a = nlohmann::json::parse(std::ifstream(out / "a" / "metrics.json"));
   ASSERT_TRUE(a["depth_registration"]["found"].get<bool>());
   run::RunOptions second;
@@ -287,15 +294,10 @@ namespace {
 // Kitchen, map of frames 0-599, session on 700-759: 0 of 60 frames localized with 30, 55 with 15; on 800-859 (see
 // below) 59, where it was 0 before neighbourhoods were matched.
 TEST(MapFile, ASessionOnALoadedMapFindsItsPlaceWhereOneKeyframeSeesLittle) {
-  const fs::path kitchen = fs::path(VARSLAM_SHARED_DIR) / "realdata" / "7scenes_redkitchen";
+  const fs::path kitchen = kitchen_folder();
   if (!fs::exists(kitchen / "rgb.txt")) GTEST_SKIP() << "no " << kitchen;
   const fs::path out = fs::temp_directory_path() / ("varslam_map_reloc_" + std::to_string(::getpid()));
-  fs::remove_all(out);
-  run::RunOptions mapping;
-  mapping.progress = false;
-  mapping.max_frames = 600;
-  mapping.save_map = out / "k.map";
-  e2e::run_with(kitchen, out / "a", mapping, {"semantic.detector=none"});
+  map_of_kitchen(out, 600);
   run::RunOptions session;
   session.progress = false;
   session.first = 700;
