@@ -155,6 +155,7 @@ inline constexpr KeySpec kKeys[] = {
     detail::integer("mapping.ba_outer_iterations", 3, 1, 100, "alternations of alpha fit and solve per Local BA"),
     detail::integer("mapping.ba_iterations", 5, 1, 1000, "solver iterations per alternation"),
     detail::integer("mapping.ba_refine_iterations", 10, 0, 1000, "solver iterations of the refine solve on the gated inliers"),
+    detail::choice("mapping.ba_solver", "schur", "schur|ceres", "Local BA solver: schur (dedicated Schur-complement Levenberg-Marquardt) or ceres (Ceres' sparse Schur); same step control, same solution, ceres about 3x slower"),
     detail::integer("mapping.triangulation_neighbours", 10, 1, 1000, "covisible keyframes searched for new points"),
     detail::integer("mapping.max_ba_keyframes", 20, 2, 10000, "keyframes optimised per Local BA (the most covisible); the others observing stay fixed"),
     detail::real("mapping.keyframe_redundancy", 0.9, 0.0, 1.0, "share of a keyframe's points seen by 3 other keyframes that makes it redundant", {}, "("),

@@ -13,6 +13,8 @@
 #include <ceres/problem.h>
 #include <ceres/solver.h>
 
+#include "optim/schur_lm.hpp"
+
 namespace varslam::optim {
 namespace {
 
@@ -40,6 +42,19 @@ class BaState {
   }
 
   double* pose(int k) { return poses_.data() + static_cast<std::size_t>(k) * kPoseParams; }
+
+  /// The dedicated solver on this state (BaSolver::Schur); built on first use.
+  SchurLm& schur() {
+    if (!schur_) {
+      std::vector<bool> fixed;
+      for (const BaKeyframe& k : problem_.keyframes) fixed.push_back(k.fixed);
+      schur_ = std::make_unique<SchurLm>(cam_, problem_.observations, std::move(fixed), poses_.data(), points_.data(),
+                                         problem_.points.size());
+    }
+    return *schur_;
+  }
+  const ceres::LossFunction* mono_loss() const { return mono_loss_.get(); }
+  const ceres::LossFunction* stereo_loss() const { return stereo_loss_.get(); }
   double* point(int i) { return points_.data() + static_cast<std::size_t>(i) * 3; }
 
   void set_alpha(double alpha) {
@@ -91,7 +106,7 @@ class BaState {
   /// Removes observation j from the problem; parameter blocks left without observations leave it too
   /// (and the ordering, which must name exactly the problem's blocks).
   void deactivate(std::size_t j) {
-    if (!blocks_[j]) return;
+    if (blocks_.empty() || !blocks_[j]) return;  // not built: the dedicated solver reads the active flags itself
     ceres_->RemoveResidualBlock(blocks_[j]);
     blocks_[j] = nullptr;
     const BaObservation& o = problem_.observations[j];
@@ -125,6 +140,7 @@ class BaState {
   std::shared_ptr<ceres::ParameterBlockOrdering> ordering_;
   std::vector<ceres::ResidualBlockId> blocks_;  // per observation; nullptr = not in the problem
   std::vector<int> pose_uses_, point_uses_;     // active observations per parameter block
+  std::unique_ptr<SchurLm> schur_;
 };
 
 /// The alternation's alpha refits as checkpoints inside a Ceres solve (BarronAdaptive). Checkpoint k sits at
@@ -208,13 +224,29 @@ BaResult solve_local_ba(const PinholeCamera& cam, BaProblem& problem, const BaCo
   // when the alternation has settled).
   bool converged = false;
   double solved_alpha = alpha;
-  auto solve = [&](ceres::Problem& ceres_problem, int iterations) {
-    if (iterations <= 0 || ceres_problem.NumResidualBlocks() == 0) return 0;
+  const bool dedicated = cfg.solver == BaSolver::Schur;
+  std::vector<bool> active(n, true);
+  auto solve = [&](int iterations) {
+    if (iterations <= 0 || std::none_of(active.begin(), active.end(), [](bool a) { return a; })) return 0;
     if (converged && alpha == solved_alpha) return 0;
     solved_alpha = alpha;  // before the solve: a checkpoint inside it may change alpha
+    if (dedicated) {
+      const SchurLmSummary s = state.schur().solve(
+          active, state.mono_loss(), state.stereo_loss(), iterations, [&](int iteration) {
+            ceres::IterationSummary is;
+            is.iteration = iteration;
+            for (ceres::IterationCallback* cb : options.callbacks)
+              if ((*cb)(is) != ceres::SOLVER_CONTINUE) return false;
+            return true;
+          });
+      result.solver_iterations += s.iterations;
+      ++result.solves;
+      converged = s.converged;
+      return s.iterations;
+    }
     options.max_num_iterations = iterations;
     ceres::Solver::Summary summary;
-    ceres::Solve(options, &ceres_problem, &summary);
+    ceres::Solve(options, &state.ceres_problem(), &summary);
     const int ran = static_cast<int>(summary.iterations.size()) - 1;
     result.solver_iterations += ran;
     ++result.solves;
@@ -224,9 +256,10 @@ BaResult solve_local_ba(const PinholeCamera& cam, BaProblem& problem, const BaCo
 
   // Phase 1: every observation; adaptive alpha alternates with the solver on the same problem (the losses are
   // re-evaluated by every solver iteration, so changing their alpha between solves is all it takes).
-  std::vector<bool> active(n, true);
-  state.build(active);
-  options.linear_solver_ordering = state.ordering();
+  if (!dedicated) {
+    state.build(active);
+    options.linear_solver_ordering = state.ordering();
+  }
   if (adaptive) {
     if (cfg.alpha_start != AlphaStart::SolveFirst) {
       refit_alpha(active);
@@ -245,7 +278,7 @@ BaResult solve_local_ba(const PinholeCamera& cam, BaProblem& problem, const BaCo
     int clock = 0;  // phase-1 iterations on the fixed schedule's clock
     while (clock < budget) {
       checkpoints.start_solve(clock);
-      clock += solve(state.ceres_problem(), budget - clock);
+      clock += solve(budget - clock);
       if (checkpoints.alpha_moved()) continue;                 // go on with the new alpha
       if (checkpoints.reached() >= cfg.outer_iterations) break;  // Ceres stopped after the last checkpoint
       clock = checkpoints.take_next();  // Ceres stopped early: refit on its final state, as the fixed schedule
@@ -253,7 +286,7 @@ BaResult solve_local_ba(const PinholeCamera& cam, BaProblem& problem, const BaCo
     options.callbacks.clear();
     options.update_state_every_iteration = false;
   } else {
-    solve(state.ceres_problem(), cfg.outer_iterations * cfg.iterations);
+    solve(cfg.outer_iterations * cfg.iterations);
   }
 
   // Outlier gate on the state after phase 1.
@@ -279,7 +312,7 @@ BaResult solve_local_ba(const PinholeCamera& cam, BaProblem& problem, const BaCo
   // Phase 2: refine on the surviving observations (same problem, outliers removed).
   if (cfg.refine_iterations > 0) {
     if (adaptive) refit_alpha(active);
-    solve(state.ceres_problem(), cfg.refine_iterations);
+    solve(cfg.refine_iterations);
   }
 
   state.write_back(problem);

@@ -36,6 +36,10 @@ enum class AlphaStart {
   SolveFirst,
 };
 
+/// Which solver runs the Local BA iterations: the dedicated Schur-complement LM (optim/schur_lm.hpp) or Ceres'
+/// general sparse Schur solver, with the same step control; kept to compare the two.
+enum class BaSolver { Schur, Ceres };
+
 struct BaConfig;
 /// Sees a problem before solve_local_ba solves it (bench/kernel_cost_bench records the Local BA problems of a
 /// real run to replay them under other kernels). Called from the solving thread.
@@ -48,7 +52,8 @@ struct BaConfig {
   int iterations = 5;
   int refine_iterations = 10;  // second phase, after the outlier gate
   bool remove_outliers = true;
-  int max_threads = 1;
+  BaSolver solver = BaSolver::Schur;
+  int max_threads = 1;  // Ceres only
   LocalBaObserver observer;  // empty: none
 };
 
@@ -72,11 +77,11 @@ struct BaResult {
 /// Fixed kernels solve the first phase in one go; BarronAdaptive alternates: each outer iteration estimates
 /// alpha on the current active whitened residuals (fixed state), then runs `iterations` solver iterations with
 /// that alpha; the refine phase fits alpha once more on the surviving observations. The refits are checkpoints
-/// inside one Ceres solve (every `iterations` iterations): only a refit that moves alpha ends the solve and
-/// starts a new one, so an alpha that holds costs no extra preprocessing (BaResult::solves). The Ceres problem
-/// is built once: alpha changes only touch the loss objects, and the refine phase removes the outlier blocks.
-/// With kernel.chi2_gates = false only observations behind the camera are gated. Ceres SPARSE_SCHUR with
-/// points eliminated first, PoseManifold on the poses, deterministic with max_threads = 1.
+/// inside one solve (every `iterations` iterations): only a refit that moves alpha ends the solve and starts a
+/// new one (BaResult::solves). Alpha changes only touch the loss objects, and the refine phase removes the
+/// outlier observations. With kernel.chi2_gates = false only observations behind the camera are gated.
+/// BaSolver::Schur (default): optim/schur_lm.hpp. BaSolver::Ceres: Ceres SPARSE_SCHUR with points eliminated
+/// first and PoseManifold on the poses, its problem built once. Both deterministic (Ceres with max_threads = 1).
 /// Throws std::invalid_argument on an observation indexing a missing keyframe or point.
 BaResult solve_local_ba(const PinholeCamera& cam, BaProblem& problem, const BaConfig& cfg);
 

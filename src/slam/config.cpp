@@ -103,6 +103,7 @@ SlamConfig slam_config_from(const Settings& s) {
   m.ba_outer_iterations = setting<int>(s, "mapping.ba_outer_iterations");
   m.ba_iterations = setting<int>(s, "mapping.ba_iterations");
   m.ba_refine_iterations = setting<int>(s, "mapping.ba_refine_iterations");
+  m.ba_solver = setting<std::string>(s, "mapping.ba_solver") == "schur" ? optim::BaSolver::Schur : optim::BaSolver::Ceres;
   m.triangulation_neighbours = setting<int>(s, "mapping.triangulation_neighbours");
   m.max_ba_keyframes = setting<int>(s, "mapping.max_ba_keyframes");
   m.keyframe_redundancy = setting<double>(s, "mapping.keyframe_redundancy");

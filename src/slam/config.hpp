@@ -85,6 +85,8 @@ struct MappingConfig {
   int ba_outer_iterations = setting_keys::int_default("mapping.ba_outer_iterations");
   int ba_iterations = setting_keys::int_default("mapping.ba_iterations");
   int ba_refine_iterations = setting_keys::int_default("mapping.ba_refine_iterations");
+  optim::BaSolver ba_solver =
+      setting_keys::text_default("mapping.ba_solver") == "schur" ? optim::BaSolver::Schur : optim::BaSolver::Ceres;
   int triangulation_neighbours = setting_keys::int_default("mapping.triangulation_neighbours");
   int max_ba_keyframes = setting_keys::int_default("mapping.max_ba_keyframes");
   double keyframe_redundancy = setting_keys::real_default("mapping.keyframe_redundancy");

@@ -350,6 +350,7 @@ void LocalMapper::local_ba(const KeyFramePtr& kf) {
   bc.outer_iterations = cfg_.ba_outer_iterations;
   bc.iterations = cfg_.ba_iterations;
   bc.refine_iterations = cfg_.ba_refine_iterations;
+  bc.solver = cfg_.ba_solver;
   bc.observer = cfg_.ba_observer;
   const PinholeCamera& cam = kf->features().camera;
   optim::BaResult res = optim::solve_local_ba(cam, problem, bc);

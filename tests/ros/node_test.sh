@@ -71,8 +71,8 @@ done
 rosbag play -q -d 1 "$work/seq.bag" > "$work/play.log" 2>&1 &
 play=$!
 # The live viewer from the node: a client on its event stream makes it encode frames while the bag plays.
-for _ in $(seq 50); do grep -q 'viewer: open http' "$work/node.log" && break; sleep 0.1; done
-viewer_url=$(grep 'viewer: open' "$work/node.log" | grep -o 'http://127.0.0.1:[0-9]*/' | head -1)
+for _ in $(seq 300); do grep -q 'viewer: open http' "$work/node.log" && break; sleep 0.1; done
+viewer_url=$(grep 'viewer: open' "$work/node.log" | grep -o 'http://127.0.0.1:[0-9]*/' | head -1 || true)
 [[ -n $viewer_url ]] || fail "the node did not say where its viewer is"
 curl -s -N --max-time 3 "${viewer_url}events" > "$work/events.txt" || true
 wait "$play" || fail "rosbag play"
