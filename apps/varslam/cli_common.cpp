@@ -136,6 +136,15 @@ void print_run_summary(const run::RunSummary& s) {
                t["match"]["median_ms"].get<double>(), t["pose_optimization"]["median_ms"].get<double>(),
                t["local_ba"]["median_ms"].get<double>());
   }
+  if (s.metrics.contains("realtime")) {
+    const auto& r = s.metrics["realtime"];
+    fmt::print("real time        latency median {:.1f} ms, p95 {:.1f} (frame in to pose out); {} frame(s) dropped; "
+               "mapping queue median {:.0f}, max {:.0f}; Local BA skipped on {} and cut short on {} of {} keyframes\n",
+               r["latency"]["median_ms"].get<double>(), r["latency"]["p95_ms"].get<double>(),
+               r["dropped_frames"].get<long>(), r["mapping_queue"]["median"].get<double>(),
+               r["mapping_queue"]["max"].get<double>(), r["local_ba_skipped"].get<long>(),
+               r["local_ba_cut_short"].get<long>(), r["keyframes_mapped"].get<long>());
+  }
   if (s.ate_rmse)
     fmt::print("ATE              rmse {:.2f} cm, max {:.2f} cm\n", *s.ate_rmse * 100.0, *s.ate_max * 100.0);
   else if (!s.ate_note.empty())

@@ -226,13 +226,28 @@ BaResult solve_local_ba(const PinholeCamera& cam, BaProblem& problem, const BaCo
   double solved_alpha = alpha;
   const bool dedicated = cfg.solver == BaSolver::Schur;
   std::vector<bool> active(n, true);
+  const auto stop_requested = [&] {
+    if (!cfg.stop || !cfg.stop->load()) return false;
+    result.cut_short = true;
+    return true;
+  };
+  // Ends a Ceres solve when the caller asks (the dedicated solver checks through its own callback).
+  struct StopCallback final : ceres::IterationCallback {
+    std::function<bool()> requested;
+    ceres::CallbackReturnType operator()(const ceres::IterationSummary&) override {
+      return requested() ? ceres::SOLVER_TERMINATE_SUCCESSFULLY : ceres::SOLVER_CONTINUE;
+    }
+  } stop_callback;
+  stop_callback.requested = stop_requested;
   auto solve = [&](int iterations) {
     if (iterations <= 0 || std::none_of(active.begin(), active.end(), [](bool a) { return a; })) return 0;
+    if (stop_requested()) return 0;
     if (converged && alpha == solved_alpha) return 0;
     solved_alpha = alpha;  // before the solve: a checkpoint inside it may change alpha
     if (dedicated) {
       const SchurLmSummary s = state.schur().solve(
           active, state.mono_loss(), state.stereo_loss(), iterations, [&](int iteration) {
+            if (stop_requested()) return false;
             ceres::IterationSummary is;
             is.iteration = iteration;
             for (ceres::IterationCallback* cb : options.callbacks)
@@ -245,8 +260,10 @@ BaResult solve_local_ba(const PinholeCamera& cam, BaProblem& problem, const BaCo
       return s.iterations;
     }
     options.max_num_iterations = iterations;
+    if (cfg.stop) options.callbacks.insert(options.callbacks.begin(), &stop_callback);
     ceres::Solver::Summary summary;
     ceres::Solve(options, &state.ceres_problem(), &summary);
+    if (cfg.stop) options.callbacks.erase(options.callbacks.begin());
     const int ran = static_cast<int>(summary.iterations.size()) - 1;
     result.solver_iterations += ran;
     ++result.solves;
@@ -276,7 +293,7 @@ BaResult solve_local_ba(const PinholeCamera& cam, BaProblem& problem, const BaCo
     options.update_state_every_iteration = true;
     const int budget = cfg.outer_iterations * cfg.iterations;
     int clock = 0;  // phase-1 iterations on the fixed schedule's clock
-    while (clock < budget) {
+    while (clock < budget && !result.cut_short) {
       checkpoints.start_solve(clock);
       clock += solve(budget - clock);
       if (checkpoints.alpha_moved()) continue;                 // go on with the new alpha
@@ -310,7 +327,7 @@ BaResult solve_local_ba(const PinholeCamera& cam, BaProblem& problem, const BaCo
   }
 
   // Phase 2: refine on the surviving observations (same problem, outliers removed).
-  if (cfg.refine_iterations > 0) {
+  if (cfg.refine_iterations > 0 && !result.cut_short) {
     if (adaptive) refit_alpha(active);
     solve(cfg.refine_iterations);
   }

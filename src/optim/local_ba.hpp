@@ -1,5 +1,6 @@
 #pragma once
 // Local Bundle Adjustment for local mapping on plain data: keyframe poses T_cw, world points, observations.
+#include <atomic>
 #include <functional>
 #include <vector>
 
@@ -54,6 +55,10 @@ struct BaConfig {
   bool remove_outliers = true;
   BaSolver solver = BaSolver::Schur;
   int max_threads = 1;  // Ceres only
+  // Set by another thread when the solve should end early (real time: a newer keyframe waits). The solve stops
+  // after its current iteration, skips what is left, and keeps the state it reached (every accepted step lowered
+  // the cost). nullptr: never.
+  const std::atomic<bool>* stop = nullptr;
   LocalBaObserver observer;  // empty: none
 };
 
@@ -70,6 +75,7 @@ struct BaResult {
   double initial_cost = 0, final_cost = 0;
   int solver_iterations = 0;  // total over all Ceres solves
   int solves = 0;             // Ceres solves run (each one preprocesses the problem again)
+  bool cut_short = false;     // BaConfig::stop ended it before its schedule
 };
 
 /// Local BA: optimise non-fixed keyframes and all points in place. ORB-SLAM-style schedule: solve, then mark

@@ -32,6 +32,7 @@ struct FrameResult {
   // The pose tracking gave the frame, camera-to-world (what a robot uses live); empty when it was not tracked.
   std::optional<Eigen::Isometry3d> T_wc;
   std::size_t map_keyframes = 0, map_points = 0;  // size of the map after this frame
+  std::size_t mapping_queue = 0;  // keyframes waiting for local mapping after this frame (real time)
 };
 
 /// The person stage on one frame: the boxes used and which keypoints the depth-aware filter dropped.

@@ -296,6 +296,7 @@ FrameResult Pipeline::track(const RgbdFrame& input, const std::optional<Detectio
   r.T_wc = out.live_T_wc;
   r.map_keyframes = system_->map().num_keyframes();
   r.map_points = system_->map().num_map_points();
+  r.mapping_queue = system_->mapping_queue();
   if (out.live_T_wc) {
     live_.push_back({frame.timestamp, *out.live_T_wc});
     ++tracked_;

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 #include <fstream>
 #include <thread>
@@ -198,8 +199,16 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const RunO
 
   // Unregistered depth is warped into the colour camera on the prefetch thread, before any stage reads it.
   FramePrefetcher prefetch(dataset, 4, first, count, slam.frame_preparation());
+  const bool realtime = options.mode == RunMode::RealTime;
+  const bool paced = realtime && options.pace;
+  std::vector<double> stamps;  // paced: when each frame is due
+  if (paced)
+    for (std::size_t i = first; i < first + count; ++i) stamps.push_back(dataset.timestamp(i));
   const auto t_start = Clock::now();
   double first_stamp = 0;
+  const auto due = [&](double stamp) {
+    return t_start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(stamp - first_stamp));
+  };
   bool interrupted = false;
   for (std::size_t n = 0;; ++n) {
     if (options.stop && options.stop->load()) {
@@ -211,11 +220,20 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const RunO
     if (!frame) break;
     metrics.add_load_ms(std::chrono::duration<double, std::milli>(Clock::now() - t_load).count());
     if (n == 0) first_stamp = frame->timestamp;
-    if (options.mode == RunMode::RealTime && options.pace) {
-      // Feed at the sensor's rate: wait until this frame's time has come.
-      std::this_thread::sleep_until(t_start + std::chrono::duration<double>(frame->timestamp - first_stamp));
+    Clock::time_point arrival = Clock::now();
+    if (paced) {
+      // As a sensor delivers: the frame arrives at its time; when tracking is free only after the next frame has
+      // arrived too, this one is dropped (a camera driver keeps the newest frame).
+      const auto next = std::upper_bound(stamps.begin(), stamps.end(), frame->timestamp);
+      if (n > 0 && next != stamps.end() && Clock::now() >= due(*next)) {
+        metrics.add_dropped_frame();
+        continue;
+      }
+      arrival = due(frame->timestamp);
+      std::this_thread::sleep_until(arrival);
     }
     slam.track(*frame);
+    if (realtime) metrics.add_latency_ms(std::chrono::duration<double, std::milli>(Clock::now() - arrival).count());
   }
   slam.finish();
   const double wall = std::chrono::duration<double>(Clock::now() - t_start).count();

@@ -49,6 +49,7 @@ void MetricsRecorder::on_frame(const FrameResult& f) {
   edge_rejected_.push_back(f.depth_edge_rejected);
   keypoints_.push_back(f.keypoints);
   depth_share_.push_back(f.keypoints > 0 ? static_cast<double>(f.keypoints_with_depth) / f.keypoints : 0.0);
+  mapping_queue_.push_back(static_cast<double>(f.mapping_queue));
 }
 
 void MetricsRecorder::on_detection(const DetectionEvent& d) {
@@ -64,6 +65,9 @@ void MetricsRecorder::on_detection(const DetectionEvent& d) {
 
 void MetricsRecorder::on_keyframe_mapped(const slam::KeyframeMapped& m) {
   keyframe_ms_.push_back(m.ms);
+  ++keyframes_mapped_;
+  ba_skipped_ += m.ba_skipped;
+  ba_cut_short_ += m.ba && m.ba->cut_short;
   triangulated_ += m.triangulated_points;
   culled_points_ += m.culled_points;
   culled_keyframes_ += m.culled_keyframes;
@@ -74,7 +78,7 @@ void MetricsRecorder::on_keyframe_mapped(const slam::KeyframeMapped& m) {
                  {"fixed_keyframes", b.fixed_keyframes}, {"points", b.points}, {"observations", b.observations},
                  {"outliers", b.outliers}, {"alpha_per_iteration", b.alpha_per_iteration},
                  {"final_alpha", b.final_alpha}, {"fitted_alpha", b.fitted_alpha}, {"refine_alpha", b.refine_alpha},
-                 {"ms", b.ms}});
+                 {"cut_short", b.cut_short}, {"ms", b.ms}});
 }
 
 nlohmann::json MetricsRecorder::metrics(const Pipeline& slam) const {
@@ -102,6 +106,17 @@ nlohmann::json MetricsRecorder::metrics(const Pipeline& slam) const {
                   {"keyframe_processing", timing_json(keyframe_ms_)}, {"local_ba", timing_json(ba_ms_)},
                   {"loop_detection", timing_json(loop_search_ms_)}};
   m["local_ba"] = ba_;
+  if (slam.mode() == RunMode::RealTime) {
+    const auto queue = median_p95(mapping_queue_);
+    m["realtime"] = {
+        {"dropped_frames", dropped_frames_},
+        {"latency", timing_json(latency_ms_)},
+        {"mapping_queue", {{"median", queue.first}, {"p95", queue.second},
+                           {"max", mapping_queue_.empty() ? 0.0 : *std::max_element(mapping_queue_.begin(), mapping_queue_.end())}}},
+        {"keyframes_mapped", keyframes_mapped_},
+        {"local_ba_skipped", ba_skipped_},
+        {"local_ba_cut_short", ba_cut_short_}};
+  }
   nlohmann::json loops = nlohmann::json::array();
   for (const slam::LoopRecord& l : loops_)
     loops.push_back({{"keyframe", l.query_keyframe}, {"loop_keyframe", l.loop_keyframe}, {"timestamp", l.timestamp},

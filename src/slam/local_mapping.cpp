@@ -164,6 +164,8 @@ void LocalMapper::process(const KeyFramePtr& kf) {
   if (queued() == 0) {
     local_ba(kf);
     if (cfg_.cull_keyframes) cull_keyframes(kf);
+  } else {
+    current_.ba_skipped = true;
   }
   remove_bad_from_map();
   current_.ms = ms_since(t0);
@@ -351,6 +353,7 @@ void LocalMapper::local_ba(const KeyFramePtr& kf) {
   bc.iterations = cfg_.ba_iterations;
   bc.refine_iterations = cfg_.ba_refine_iterations;
   bc.solver = cfg_.ba_solver;
+  if (running()) bc.stop = &abort_ba_;  // on the mapping thread a newer keyframe ends the solve; never in deterministic mode
   bc.observer = cfg_.ba_observer;
   const PinholeCamera& cam = kf->features().camera;
   optim::BaResult res = optim::solve_local_ba(cam, problem, bc);
@@ -401,6 +404,7 @@ void LocalMapper::local_ba(const KeyFramePtr& kf) {
     rec.fitted_alpha = res.fitted_alpha_per_iteration[last];
   }
   rec.refine_alpha = res.final_alpha;
+  rec.cut_short = res.cut_short;
   rec.ms = ms_since(t0);
   current_.ba = std::move(rec);
 }

@@ -41,6 +41,8 @@ class System {
   SavedMap snapshot_now(MapFingerprint fingerprint);
   /// Local mapping has nothing to do right now (always true in deterministic mode).
   bool mapping_idle() const { return mode_ != RunMode::RealTime || !mapper_.running() || mapper_.idle(); }
+  /// Keyframes waiting for local mapping (real time; always 0 in deterministic mode after process()).
+  std::size_t mapping_queue() const { return mapper_.queued(); }
   void set_localization_only(bool on) { tracker_.set_localization_only(on); }
   void set_pose_hint(const Eigen::Isometry3d& T_wc, double radius_m) { tracker_.set_pose_hint(T_wc, radius_m); }
 

@@ -17,6 +17,7 @@ struct BaRecord {
   double final_alpha = 2.0;   // alpha of the last alternation before the outlier gate
   double fitted_alpha = 2.0;  // the fit behind final_alpha, before mapping.alpha_max capped it
   double refine_alpha = 2.0;  // alpha of the refine solve on the gated inliers
+  bool cut_short = false;     // real time: a newer keyframe arrived and the solve stopped before its schedule
   double ms = 0;
 };
 
@@ -29,6 +30,7 @@ struct KeyframeMapped {
   int culled_points = 0;          // recent points removed as unreliable
   int culled_keyframes = 0;       // redundant keyframes removed around it
   std::optional<BaRecord> ba;     // empty when Local BA did not run (a newer keyframe waited, or nothing to solve)
+  bool ba_skipped = false;        // real time: Local BA did not run because a newer keyframe waited
 };
 
 /// One closed loop.

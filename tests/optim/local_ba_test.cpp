@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cstdio>
 #include <random>
 
@@ -238,6 +239,28 @@ TEST(LocalBa, AMovingAlphaRestartsTheSolveAtItsCheckpoint) {
   EXPECT_GE(r.solves, 1 + moves);
   EXPECT_LE(r.solves, cfg.outer_iterations + 1);
   EXPECT_LE(r.solver_iterations, cfg.outer_iterations * cfg.iterations + cfg.refine_iterations);
+}
+
+// A stop request (real time: a newer keyframe waits) ends the solve; the state it keeps is one the solver reached,
+// so with the request standing from the start nothing moves, and the result says it was cut short.
+TEST(LocalBa, AStopRequestEndsTheSolveAndSaysSo) {
+  for (const BaSolver solver : {BaSolver::Schur, BaSolver::Ceres}) {
+    const SyntheticBa s = small_problem(3);
+    BaProblem p = s.initial;
+    BaConfig cfg = ba_config(KernelType::BarronAdaptive);
+    cfg.solver = solver;
+    const std::atomic<bool> stop{true};
+    cfg.stop = &stop;
+    const BaResult r = solve_local_ba(PinholeCamera{}, p, cfg);
+    EXPECT_TRUE(r.cut_short);
+    EXPECT_EQ(r.solver_iterations, 0);
+    EXPECT_LT(mean_translation_error(p, s.initial), 1e-12);  // poses go through a quaternion and back
+    EXPECT_EQ(point_rmse(p, s.initial), 0.0);
+    BaProblem q = s.initial;
+    cfg.stop = nullptr;
+    EXPECT_FALSE(solve_local_ba(PinholeCamera{}, q, cfg).cut_short);
+    EXPECT_LT(mean_translation_error(q, s.truth), mean_translation_error(s.initial, s.truth));
+  }
 }
 
 TEST(LocalBa, RejectsObservationOfMissingPoint) {

@@ -101,6 +101,31 @@ TEST(EndToEnd, RealTimeModeTracksTheSameSequence) {
   EXPECT_LT(*s.ate_rmse, 0.03);
 }
 
+// Paced real time reports what a robot would see: every frame either tracked (with its latency) or dropped because
+// a newer one had arrived, the mapping queue, and which keyframes' Local BA was skipped or cut short.
+TEST(EndToEnd, PacedRealTimeAccountsForEveryFrameAndReportsLatency) {
+  const fs::path seq = static_sequence();
+  run::RunOptions ro;
+  ro.mode = RunMode::RealTime;
+  ro.pace = true;
+  ro.progress = false;
+  const RunSummary s = e2e::run_with(seq, test_dir("rt_paced"), ro);
+  const auto& m = s.metrics;
+  ASSERT_TRUE(m.contains("realtime"));
+  const auto& r = m["realtime"];
+  const std::size_t total = open_dataset(seq, settings_for_dataset(seq, std::nullopt))->size();
+  EXPECT_EQ(s.frames + r["dropped_frames"].get<std::size_t>(), total);
+  EXPECT_EQ(r["latency"]["count"].get<std::size_t>(), s.frames);
+  EXPECT_GT(r["latency"]["median_ms"].get<double>(), 0.0);
+  EXPECT_GE(r["latency"]["p95_ms"].get<double>(), r["latency"]["median_ms"].get<double>());
+  EXPECT_EQ(r["keyframes_mapped"].get<long>(), m["timings"]["keyframe_processing"]["count"].get<long>());
+  EXPECT_LE(r["local_ba_skipped"].get<long>() + static_cast<long>(m["local_ba"].size()), r["keyframes_mapped"].get<long>());
+  EXPECT_LE(r["local_ba_cut_short"].get<long>(), static_cast<long>(m["local_ba"].size()));
+  EXPECT_GE(r["mapping_queue"]["max"].get<double>(), r["mapping_queue"]["median"].get<double>());
+  // Deterministic runs have no such block: nothing there is timing-dependent.
+  EXPECT_FALSE(run_on(seq, test_dir("det_no_rt"), RunMode::Deterministic, 20).metrics.contains("realtime"));
+}
+
 // A large box carried 0.6-1.5 m in front of the camera (4 s along fr3_sitting_static, seed 4): the box has more
 // matches than the room behind it, and as it is carried out of the view tracking follows it unless the near-mover
 // check solves the pose on the room. The test shows both sides, so it fails if the scene stops dragging.
