@@ -1,0 +1,463 @@
+#include "report/bench_plan.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+#include <unistd.h>
+
+#include "core/error.hpp"
+#include "io/output_folder.hpp"
+#include "report/bench_files.hpp"
+#include "report/bench_job.hpp"
+#include "report/machine_info.hpp"
+#include "report/process_pool.hpp"
+
+namespace varslam::report {
+namespace fs = std::filesystem;
+namespace {
+
+// Peer template placeholders become shell-quoted paths; the command runs through /bin/sh.
+std::string expand_peer_template(const std::string& tmpl, const SequenceSpec& seq, const fs::path& out_dir) {
+  std::string s = tmpl;
+  const std::vector<std::pair<std::string, std::string>> subs = {
+      {"{dataset}", shell_quote(seq.dir.string())},
+      {"{settings}", shell_quote((seq.dir / "settings.yaml").string())},
+      {"{out}", shell_quote(out_dir.string())}};
+  for (const auto& [key, value] : subs) {
+    for (auto pos = s.find(key); pos != std::string::npos; pos = s.find(key, pos + value.size()))
+      s.replace(pos, key.size(), value);
+  }
+  return s;
+}
+
+// What a scheduler should grant a job. Measured on this project's 2-core machine (BENCHMARKS.md): synth takes
+// ~8 s of wall time per second of sequence, a run ~3 s; the limits are four times that plus two minutes, so a
+// slower node does not kill a healthy job. A real folder's length is not known here: an hour. A --timeout
+// bounds the job itself, so the limit is that plus a minute to write the report.
+void set_resources(PlanJob& job, const SequenceSpec& seq, double timeout_seconds) {
+  const double per_second = job.kind == PlanJob::Kind::Synth ? 8.0 : 3.0;
+  job.time_limit_seconds = seq.real ? 3600.0 : 120.0 + 4.0 * per_second * seq.seconds;
+  if (timeout_seconds > 0) job.time_limit_seconds = timeout_seconds + 60.0;
+  // Peak resident memory of a 3-s synth is ~0.3 GB and of a run ~0.5 GB (YOLO loaded); twice that and more.
+  job.memory_mb = job.kind == PlanJob::Kind::Synth ? 1024 : 2048;
+}
+
+std::vector<std::string> run_arguments(const BenchOptions& o, const fs::path& exe, const SequenceSpec& seq,
+                                       const BenchConfiguration& config, const std::string& detector,
+                                       const fs::path& boxes, const fs::path& run_dir) {
+  // A run that tracks little is a result here (its ATE and tracked share go into the table), not a failure.
+  std::vector<std::string> argv{exe.string(), "run", "--dataset", seq.dir.string(), "--out", run_dir.string(), "-q",
+                                "--min-tracked-share", "0"};
+  if (o.realtime) argv.emplace_back("--realtime");
+  for (const auto& s : configuration_overrides(config, detector, boxes)) {
+    argv.emplace_back("--set");
+    argv.push_back(s);
+  }
+  for (const auto& s : o.extra_sets) {
+    argv.emplace_back("--set");
+    argv.push_back(s);
+  }
+  return argv;
+}
+
+// The detector a semantic configuration uses on `seq`: --detector, or for auto the ground-truth boxes where the
+// sequence has them and YOLO elsewhere. Empty for configurations without a detector.
+std::string detector_for(const BenchOptions& o, const BenchConfiguration& config, const SequenceSpec& seq,
+                         fs::path& boxes) {
+  if (!config.semantic) return "";
+  const bool has_boxes = !seq.real || fs::exists(seq.dir / "boxes.txt");
+  const std::string detector = o.detector == "auto" ? (has_boxes ? "boxes" : "yolo") : o.detector;
+  if (detector == "boxes") {
+    if (!has_boxes)
+      throw InputError(seq.dir.string() + ": no boxes.txt for --detector boxes (use --detector yolo or auto)");
+    boxes = seq.dir / "boxes.txt";
+  }
+  return detector;
+}
+
+void validate_options(const BenchOptions& o) {
+  if (!(o.seconds > 0)) throw InputError("bench: --seconds must be positive");
+  for (const auto& c : o.configs) (void)configuration_by_name(c);
+  if (o.configs.empty()) throw InputError("bench: no configuration given");
+  if (o.detector != "auto" && o.detector != "boxes" && o.detector != "yolo")
+    throw InputError("bench: --detector must be auto, boxes or yolo, got '" + o.detector + "'");
+}
+
+std::vector<SequenceSpec> plan_sequences(const BenchOptions& o, const fs::path& cache) {
+  std::vector<CameraPathChoice> paths;
+  if (!o.scenarios.empty())
+    for (const auto& p : o.paths) paths.push_back(resolve_camera_path(p, o.trajectories_dir, o.seconds));
+  std::vector<SequenceSpec> sequences =
+      paths.empty() ? std::vector<SequenceSpec>{} : synthetic_sequences(o.scenarios, paths, o.seeds, o.seconds, cache);
+  for (const auto& r : o.real) sequences.push_back(real_sequence(r));
+  if (sequences.empty()) throw InputError("bench: nothing to run (no scenario x path and no --real folder)");
+  for (const auto& seq : sequences) {
+    if (!seq.real && fs::exists(seq.dir) && !generated_by_bench(seq.dir))
+      throw InputError(seq.dir.string() + ": exists and is not a cached benchmark sequence; remove it");
+  }
+  return sequences;
+}
+
+nlohmann::json options_json(const BenchOptions& o, const fs::path& cache) {
+  return {{"scenarios", o.scenarios},       {"paths", o.paths},
+          {"seeds", o.seeds},               {"seconds", o.seconds},
+          {"configs", o.configs},           {"jobs", o.jobs},
+          {"detector", o.detector},         {"realtime", o.realtime},
+          {"extra_sets", o.extra_sets},     {"timeout_seconds", o.timeout_seconds},
+          {"peer_template", o.peer_template}, {"peer_trajectory", o.peer_trajectory},
+          {"cache_dir", cache.string()}};
+}
+
+std::string new_plan_id(const std::string& created_utc) {
+  const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                      std::chrono::system_clock::now().time_since_epoch())
+                      .count();
+  return fmt::format("{}-{}-{}", created_utc, ::getpid(), ns % 1000000000);
+}
+
+// ---- reading --------------------------------------------------------------------------------------------------
+
+// Where a key is read from, for error messages: "<file> line 3".
+struct Where {
+  const fs::path& file;
+  std::size_t line;
+  std::string str() const { return fmt::format("{} line {}", file.string(), line); }
+};
+
+const nlohmann::json& key(const nlohmann::json& j, const char* name, nlohmann::json::value_t type, const Where& w) {
+  if (!j.contains(name)) throw InputError(fmt::format("{}: key '{}' is missing", w.str(), name));
+  const nlohmann::json& v = j.at(name);
+  const bool number_ok = type == nlohmann::json::value_t::number_float && v.is_number();
+  const bool unsigned_ok = type == nlohmann::json::value_t::number_unsigned && v.is_number_unsigned();
+  if (v.type() != type && !number_ok && !unsigned_ok)
+    throw InputError(fmt::format("{}: key '{}' has the wrong type ({})", w.str(), name, v.type_name()));
+  return v;
+}
+
+std::string key_string(const nlohmann::json& j, const char* name, const Where& w) {
+  return key(j, name, nlohmann::json::value_t::string, w).get<std::string>();
+}
+double key_number(const nlohmann::json& j, const char* name, const Where& w) {
+  return key(j, name, nlohmann::json::value_t::number_float, w).get<double>();
+}
+std::size_t key_count(const nlohmann::json& j, const char* name, const Where& w) {
+  return key(j, name, nlohmann::json::value_t::number_unsigned, w).get<std::size_t>();
+}
+bool key_bool(const nlohmann::json& j, const char* name, const Where& w) {
+  return key(j, name, nlohmann::json::value_t::boolean, w).get<bool>();
+}
+std::vector<std::string> key_strings(const nlohmann::json& j, const char* name, const Where& w) {
+  const auto& a = key(j, name, nlohmann::json::value_t::array, w);
+  std::vector<std::string> out;
+  for (const auto& v : a) {
+    if (!v.is_string()) throw InputError(fmt::format("{}: key '{}' must hold strings", w.str(), name));
+    out.push_back(v.get<std::string>());
+  }
+  return out;
+}
+
+PlanJob::Kind kind_from_name(const std::string& name, const Where& w) {
+  for (const auto k : {PlanJob::Kind::Synth, PlanJob::Kind::Run, PlanJob::Kind::Peer})
+    if (kind_name(k) == name) return k;
+  throw InputError(fmt::format("{}: key 'kind' is '{}', expected synth, run or peer", w.str(), name));
+}
+
+SequenceSpec sequence_from_json(const nlohmann::json& j, const Where& w) {
+  SequenceSpec s;
+  s.id = key_string(j, "id", w);
+  s.scenario = key_string(j, "scenario", w);
+  s.path_name = key_string(j, "path", w);
+  s.dir = key_string(j, "dir", w);
+  s.real = key_bool(j, "real", w);
+  if (!s.real) {
+    s.path_file = key_string(j, "path_file", w);
+    s.path_start = key_number(j, "path_start_s", w);
+    s.seed = key_count(j, "seed", w);
+    s.seconds = key_number(j, "seconds", w);
+  }
+  return s;
+}
+
+PlanJob job_from_json(const nlohmann::json& j, const Where& w) {
+  PlanJob job;
+  job.number = key_count(j, "job", w);
+  job.kind = kind_from_name(key_string(j, "kind", w), w);
+  job.sequence = key_string(j, "sequence", w);
+  job.config = key_string(j, "config", w);
+  job.detector = key_string(j, "detector", w);
+  job.argv = key_strings(j, "argv", w);
+  if (job.argv.empty()) throw InputError(fmt::format("{}: key 'argv' is empty", w.str()));
+  job.command = key_string(j, "command", w);
+  job.out_dir = key_string(j, "out", w);
+  job.log_file = key_string(j, "log", w);
+  for (const auto& n : key(j, "needs", nlohmann::json::value_t::array, w)) {
+    if (!n.is_number_unsigned()) throw InputError(fmt::format("{}: key 'needs' must hold job numbers", w.str()));
+    job.needs.push_back(n.get<std::size_t>());
+  }
+  job.stage = static_cast<int>(key_count(j, "stage", w));
+  job.timeout_seconds = key_number(j, "timeout_s", w);
+  job.time_limit_seconds = key_number(j, "time_limit_s", w);
+  job.memory_mb = static_cast<int>(key_count(j, "memory_mb", w));
+  return job;
+}
+
+// The plan file keeps its keys in this order (format and version first), for people reading it.
+nlohmann::ordered_json ordered(const nlohmann::json& j) { return nlohmann::ordered_json::parse(j.dump()); }
+
+nlohmann::ordered_json header_json(const BenchPlan& p) {
+  nlohmann::ordered_json seqs = nlohmann::ordered_json::array();
+  for (const auto& s : p.sequences) seqs.push_back(ordered(to_json(s)));
+  return {{"format", kBenchPlanFormat},
+          {"version", kBenchPlanVersion},
+          {"id", p.id},
+          {"created_utc", p.created_utc},
+          {"dir", p.dir.string()},
+          {"executable", p.executable.string()},
+          {"git_describe", p.git_describe},
+          {"command_line", p.command_line},
+          {"machine", ordered(p.machine)},
+          {"options", ordered(p.options)},
+          {"configs", p.configs},
+          {"peer", p.peer},
+          {"peer_name", p.peer_name},
+          {"peer_trajectory", p.peer_trajectory},
+          {"jobs", p.jobs.size()},
+          {"sequences", seqs}};
+}
+
+// Fills the plan from its header line; returns the number of jobs the header announces.
+std::size_t read_header(BenchPlan& p, const nlohmann::json& h, const Where& w) {
+  if (!h.is_object() || !h.contains("format") || h["format"] != kBenchPlanFormat)
+    throw InputError(fmt::format("{}: not a varslam bench plan (its first line needs \"format\": \"{}\")", w.str(),
+                                 kBenchPlanFormat));
+  const nlohmann::json& version = key(h, "version", nlohmann::json::value_t::number_unsigned, w);
+  if (version.get<std::size_t>() != static_cast<std::size_t>(kBenchPlanVersion))
+    throw InputError(fmt::format("{}: key 'version' is {}, this varslam reads plan version {}; plan it again with "
+                                 "this varslam (varslam bench plan)",
+                                 w.str(), version.dump(), kBenchPlanVersion));
+  p.id = key_string(h, "id", w);
+  p.created_utc = key_string(h, "created_utc", w);
+  p.executable = key_string(h, "executable", w);
+  p.git_describe = key_string(h, "git_describe", w);
+  p.command_line = key_string(h, "command_line", w);
+  p.machine = key(h, "machine", nlohmann::json::value_t::object, w);
+  p.options = key(h, "options", nlohmann::json::value_t::object, w);
+  p.configs = key_strings(h, "configs", w);
+  p.peer = key_bool(h, "peer", w);
+  p.peer_name = key_string(h, "peer_name", w);
+  p.peer_trajectory = key_string(h, "peer_trajectory", w);
+  for (const auto& s : key(h, "sequences", nlohmann::json::value_t::array, w)) p.sequences.push_back(sequence_from_json(s, w));
+  return key_count(h, "jobs", w);
+}
+
+}  // namespace
+
+std::string kind_name(PlanJob::Kind kind) {
+  switch (kind) {
+    case PlanJob::Kind::Synth: return "synth";
+    case PlanJob::Kind::Run: return "run";
+    case PlanJob::Kind::Peer: return "peer";
+  }
+  return "?";
+}
+
+const SequenceSpec& BenchPlan::sequence(const std::string& sequence_id) const {
+  for (const auto& s : sequences)
+    if (s.id == sequence_id) return s;
+  throw InputError(fmt::format("{}: no sequence '{}' in the plan's header", file().string(), sequence_id));
+}
+
+const PlanJob& BenchPlan::job(std::size_t number) const {
+  if (number >= jobs.size())
+    throw InputError(fmt::format("job {}: {} has {} jobs, numbered 0 to {}", number, file().string(), jobs.size(),
+                                 jobs.empty() ? 0 : jobs.size() - 1));
+  return jobs[number];
+}
+
+BenchPlan make_bench_plan(const BenchOptions& o) {
+  validate_options(o);
+  BenchPlan p;
+  p.dir = fs::absolute(o.out).lexically_normal();
+  const fs::path cache = o.cache_dir.empty() ? p.dir / "sequences" : fs::absolute(o.cache_dir).lexically_normal();
+  p.executable = o.executable.empty() ? self_executable() : fs::absolute(o.executable);
+  p.created_utc = utc_now_iso8601();
+  p.id = new_plan_id(p.created_utc);
+  p.git_describe = git_describe(p.executable.parent_path());
+  p.command_line = o.command_line;
+  p.machine = to_json(sample_machine_info());
+  p.options = options_json(o, cache);
+  p.configs = o.configs;
+  p.peer = !o.peer_template.empty();
+  p.peer_name = o.peer_name;
+  p.peer_trajectory = o.peer_trajectory;
+  p.sequences = plan_sequences(o, cache);
+
+  const auto add = [&p](PlanJob job, const SequenceSpec& seq, double timeout) -> std::size_t {
+    job.number = p.jobs.size();
+    job.sequence = seq.id;
+    job.timeout_seconds = timeout;
+    for (const auto n : job.needs) job.stage = std::max(job.stage, p.jobs[n].stage + 1);
+    set_resources(job, seq, timeout);
+    p.jobs.push_back(std::move(job));
+    return p.jobs.back().number;
+  };
+  // Sequences first: every synth job is in stage 0, every job reading a sequence after it.
+  std::vector<std::vector<std::size_t>> needs(p.sequences.size());
+  for (std::size_t si = 0; si < p.sequences.size(); ++si) {
+    const SequenceSpec& seq = p.sequences[si];
+    if (seq.real) continue;
+    PlanJob job;
+    job.kind = PlanJob::Kind::Synth;
+    job.argv = {p.executable.string()};
+    for (auto& a : synth_arguments(seq)) job.argv.push_back(std::move(a));
+    job.command = shell_join(job.argv);
+    job.out_dir = seq.dir;
+    job.log_file = cache / "logs" / (seq.id + ".synth.log");
+    needs[si] = {add(std::move(job), seq, o.timeout_seconds)};
+  }
+  for (std::size_t si = 0; si < p.sequences.size(); ++si) {
+    const SequenceSpec& seq = p.sequences[si];
+    for (const auto& config_name : o.configs) {
+      const BenchConfiguration& config = configuration_by_name(config_name);
+      fs::path boxes;
+      PlanJob job;
+      job.kind = PlanJob::Kind::Run;
+      job.config = config_name;
+      job.detector = detector_for(o, config, seq, boxes);
+      job.out_dir = p.dir / "runs" / seq.id / config_name;
+      job.argv = run_arguments(o, p.executable, seq, config, job.detector, boxes, job.out_dir);
+      job.command = shell_join(job.argv);
+      job.log_file = job.out_dir / "run.log";
+      job.needs = needs[si];
+      add(std::move(job), seq, o.timeout_seconds);
+    }
+    if (p.peer) {
+      PlanJob job;
+      job.kind = PlanJob::Kind::Peer;
+      job.config = "peer";
+      job.out_dir = p.dir / "peer" / seq.id;
+      job.command = expand_peer_template(o.peer_template, seq, job.out_dir);
+      job.argv = {"/bin/sh", "-c", job.command};
+      job.log_file = job.out_dir / "peer.log";
+      job.needs = needs[si];
+      add(std::move(job), seq, o.timeout_seconds);
+    }
+  }
+  return p;
+}
+
+std::unique_ptr<OutputFolder> claim_bench_folder(const fs::path& out) {
+  // The plan and the summary files are the benchmark's own; each run folder is its run's (varslam run keeps its
+  // manifest).
+  return std::make_unique<OutputFolder>(fs::absolute(out).lexically_normal(),
+                                        std::vector<OutputFile>{{kBenchPlanFile, "benchmark plan"},
+                                                                {"results.json", "benchmark results"},
+                                                                {"table.md", "benchmark table"},
+                                                                {"index.html", "benchmark summary"}});
+}
+
+void write_bench_plan(const BenchPlan& p, bool fresh_sequences) {
+  for (const auto& job : p.jobs) {
+    if (job.kind == PlanJob::Kind::Synth) {
+      if (fresh_sequences) forget_cached_sequence(job);
+      fs::create_directories(job.log_file.parent_path());
+      continue;
+    }
+    fs::create_directories(job.out_dir);
+    // A stale metrics.json (or trajectory) from an earlier benchmark must not pass for this plan's result.
+    clear_job_outputs(p, job);
+  }
+  std::string text = header_json(p).dump() + "\n";
+  for (const auto& job : p.jobs) text += job_line(job).dump() + "\n";
+  write_text_file(p.file(), text);
+}
+
+BenchPlan read_bench_plan(const fs::path& dir) {
+  if (!fs::is_directory(dir))
+    throw InputError(fmt::format("{}: no such folder (give the --out folder of varslam bench plan)", dir.string()));
+  BenchPlan p;
+  p.dir = fs::absolute(dir).lexically_normal();
+  const fs::path file = p.file();
+  if (!fs::exists(file))
+    throw InputError(fmt::format("{}: not found; write a plan with varslam bench plan --out {}", file.string(),
+                                 dir.string()));
+  std::istringstream in(read_text_file(file));
+  std::string line;
+  std::size_t line_no = 0, announced = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line.empty()) continue;
+    const Where w{file, line_no};
+    nlohmann::json j;
+    try {
+      j = nlohmann::json::parse(line);
+    } catch (const nlohmann::json::exception& e) {
+      throw InputError(fmt::format("{}: not JSON ({})", w.str(), e.what()));
+    }
+    if (line_no == 1) {
+      announced = read_header(p, j, w);
+      continue;
+    }
+    if (!j.is_object()) throw InputError(fmt::format("{}: a job line must be a JSON object", w.str()));
+    PlanJob job = job_from_json(j, w);
+    if (job.number != p.jobs.size())
+      throw InputError(fmt::format("{}: key 'job' is {}, expected {} (jobs are numbered in order)", w.str(),
+                                   job.number, p.jobs.size()));
+    for (const auto n : job.needs)
+      if (n >= job.number)
+        throw InputError(fmt::format("{}: key 'needs' names job {}, which is not an earlier job", w.str(), n));
+    (void)p.sequence(job.sequence);
+    p.jobs.push_back(std::move(job));
+  }
+  if (line_no == 0) throw InputError(fmt::format("{}: empty, not a varslam bench plan", file.string()));
+  if (p.jobs.size() != announced)
+    throw InputError(fmt::format("{}: key 'jobs' of the header announces {} jobs, the file has {} (cut short?)",
+                                 file.string(), announced, p.jobs.size()));
+  return p;
+}
+
+std::vector<std::size_t> jobs_of_stage(const BenchPlan& plan, int stage) {
+  std::vector<std::size_t> out;
+  for (const auto& j : plan.jobs)
+    if (j.stage == stage) out.push_back(j.number);
+  return out;
+}
+
+int stage_count(const BenchPlan& plan) {
+  int n = 0;
+  for (const auto& j : plan.jobs) n = std::max(n, j.stage + 1);
+  return n;
+}
+
+nlohmann::json to_json(const PlanJob& j) { return nlohmann::json::parse(job_line(j).dump()); }
+
+nlohmann::ordered_json job_line(const PlanJob& j) {
+  return {{"job", j.number},
+          {"kind", kind_name(j.kind)},
+          {"sequence", j.sequence},
+          {"config", j.config},
+          {"detector", j.detector},
+          {"stage", j.stage},
+          {"needs", j.needs},
+          {"out", j.out_dir.string()},
+          {"log", j.log_file.string()},
+          {"timeout_s", j.timeout_seconds},
+          {"time_limit_s", j.time_limit_seconds},
+          {"memory_mb", j.memory_mb},
+          {"command", j.command},
+          {"argv", j.argv}};
+}
+
+nlohmann::json to_json(const SequenceSpec& s) {
+  nlohmann::json j = {{"id", s.id}, {"scenario", s.scenario}, {"path", s.path_name}, {"dir", s.dir.string()},
+                      {"real", s.real}};
+  if (!s.real)
+    j.update({{"path_file", s.path_file.string()}, {"path_start_s", s.path_start}, {"seed", s.seed},
+              {"seconds", s.seconds}});
+  return j;
+}
+
+}  // namespace varslam::report
