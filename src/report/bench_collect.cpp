@@ -113,19 +113,21 @@ RunRecord record_of_job(const BenchPlan& plan, const PlanJob& job, const JobMark
   return r;
 }
 
-BenchOutcome collect_benchmark(const BenchPlan& plan, const CollectOptions& o) {
-  const auto log = [&o](const std::string& line) {
-    if (o.log) o.log(line);
-    else fmt::print("{}\n", line);
-  };
-  BenchOutcome result;
-  result.out = plan.dir;
-  // Records in plan order (completion order depends on the executor), so tables and JSON are stable.
+namespace {
+
+// The records of the jobs that ended, in plan order (completion order depends on the executor, so tables and JSON
+// are stable), their results.json entries, and the jobs that have not ended.
+struct EndedJobs {
   std::vector<RunRecord> records;
   nlohmann::json runs = nlohmann::json::array();
+  std::vector<std::size_t> missing;
+};
+
+EndedJobs gather_ended_jobs(const BenchPlan& plan) {
+  EndedJobs e;
   for (const auto& job : plan.jobs) {
     if (job_state(plan, job) == JobState::Missing) {
-      result.missing.push_back(job.number);
+      e.missing.push_back(job.number);
       continue;
     }
     if (job.kind == PlanJob::Kind::Synth) continue;
@@ -138,48 +140,67 @@ BenchOutcome collect_benchmark(const BenchPlan& plan, const CollectOptions& o) {
     j["process_wall_seconds"] = marker->wall_seconds;
     if (!job.detector.empty()) j["detector"] = job.detector;
     if (job.kind == PlanJob::Kind::Run) j["metrics"] = metrics;
-    runs.push_back(std::move(j));
-    records.push_back(std::move(r));
+    e.runs.push_back(std::move(j));
+    e.records.push_back(std::move(r));
   }
-  result.runs = records.size();
-  for (const auto& r : records) result.failed += !r.ok;
-  result.wall_seconds = std::isfinite(o.wall_seconds) ? o.wall_seconds : seconds_since(plan.created_utc);
+  return e;
+}
 
+nlohmann::json results_json(const BenchPlan& plan, const EndedJobs& ended, const BenchOutcome& outcome) {
+  nlohmann::json sequences = nlohmann::json::array();
+  for (const auto& s : plan.sequences) sequences.push_back(sequence_json(plan, s));
+  return {{"tool", "varslam bench"},
+          {"version", {{"git_describe", plan.git_describe}, {"executable", plan.executable.string()}}},
+          {"command_line", plan.command_line},
+          {"plan", plan.file().string()},
+          {"started_utc", plan.created_utc},
+          {"wall_seconds", outcome.wall_seconds},
+          {"machine", plan.machine},
+          {"load_average_1min_at_end", sample_machine_info().load_average},
+          {"options", plan.options},
+          {"configurations", configurations_json(plan.configs)},
+          {"sequences", sequences},
+          {"runs", ended.runs},
+          {"failed_runs", outcome.failed},
+          {"missing_jobs", outcome.missing},
+          {"table_markdown", outcome.table_markdown}};
+}
+
+// The first line of table.md and of the BENCHMARKS.md block: version, when, how many, where.
+std::string table_header(const BenchPlan& plan, const BenchOutcome& outcome) {
+  const MachineInfo machine = machine_info_from_json(plan.machine);
+  const std::string missing = outcome.missing.empty() ? "" : fmt::format(", {} jobs missing", outcome.missing.size());
+  return fmt::format("Benchmark {} ({}), {} runs ({} failed{}) in {:.0f} s on {}; load average {:.1f} at the start.\n\n",
+                     plan.git_describe, plan.created_utc, outcome.runs, outcome.failed, missing, outcome.wall_seconds,
+                     describe(machine), machine.load_average);
+}
+
+}  // namespace
+
+BenchOutcome collect_benchmark(const BenchPlan& plan, const CollectOptions& o) {
+  const auto log = [&o](const std::string& line) {
+    if (o.log) o.log(line);
+    else fmt::print("{}\n", line);
+  };
+  const EndedJobs ended = gather_ended_jobs(plan);
+  BenchOutcome result;
+  result.out = plan.dir;
+  result.missing = ended.missing;
+  result.runs = ended.records.size();
+  for (const auto& r : ended.records) result.failed += !r.ok;
+  result.wall_seconds = std::isfinite(o.wall_seconds) ? o.wall_seconds : seconds_since(plan.created_utc);
   TableOptions topt;
   topt.configs = plan.configs;
   topt.peer = plan.peer;
   topt.peer_name = plan.peer_name;
-  result.table_markdown = render_markdown_tables(records, topt);
+  result.table_markdown = render_markdown_tables(ended.records, topt);
+  result.results = results_json(plan, ended, result);
 
-  nlohmann::json sequences = nlohmann::json::array();
-  for (const auto& s : plan.sequences) sequences.push_back(sequence_json(plan, s));
-  const MachineInfo machine_start = machine_info_from_json(plan.machine);
-  result.results = {
-      {"tool", "varslam bench"},
-      {"version", {{"git_describe", plan.git_describe}, {"executable", plan.executable.string()}}},
-      {"command_line", plan.command_line},
-      {"plan", plan.file().string()},
-      {"started_utc", plan.created_utc},
-      {"wall_seconds", result.wall_seconds},
-      {"machine", plan.machine},
-      {"load_average_1min_at_end", sample_machine_info().load_average},
-      {"options", plan.options},
-      {"configurations", configurations_json(plan.configs)},
-      {"sequences", sequences},
-      {"runs", runs},
-      {"failed_runs", result.failed},
-      {"missing_jobs", result.missing},
-      {"table_markdown", result.table_markdown}};
-
-  const std::string missing = result.missing.empty() ? "" : fmt::format(", {} jobs missing", result.missing.size());
-  const std::string header = fmt::format(
-      "Benchmark {} ({}), {} runs ({} failed{}) in {:.0f} s on {}; load average {:.1f} at the start.\n\n",
-      plan.git_describe, plan.created_utc, result.runs, result.failed, missing, result.wall_seconds,
-      describe(machine_start), machine_start.load_average);
+  const std::string header = table_header(plan, result);
   for (const char* name : {"results.json", "table.md", "index.html"}) claim_output_file(plan.dir / name, "benchmark file");
   write_text_file(plan.dir / "results.json", result.results.dump(1) + "\n");
   write_text_file(plan.dir / "table.md", header + result.table_markdown);
-  write_text_file(plan.dir / "index.html", render_bench_summary_html(result.results, records, topt, plan.dir));
+  write_text_file(plan.dir / "index.html", render_bench_summary_html(result.results, ended.records, topt, plan.dir));
   if (!o.update_markdown.empty()) {
     const std::string reproduce = "Reproduce: `" + plan.command_line + "`\n\n";
     update_benchmarks_md(o.update_markdown, header + reproduce + result.table_markdown);

@@ -1,6 +1,9 @@
 #include "report/bench_job.hpp"
 
+#include <fcntl.h>
 #include <fmt/format.h>
+#include <sys/file.h>
+#include <unistd.h>
 
 #include "core/error.hpp"
 #include "io/output_folder.hpp"
@@ -25,6 +28,33 @@ JobMarker write_marker(const BenchPlan& plan, const PlanJob& job, bool ok, int e
   write_text_file(job.out_dir / kJobMarkerFile, to_json(m).dump(1) + "\n");
   return m;
 }
+
+// Held while a job runs: a second executor starting the same job (a leftover Slurm task beside GNU parallel, two
+// `bench execute`) is refused instead of running it twice into one folder. An flock is released by the kernel
+// when its process dies, so a killed job leaves no stale lock. Beside the log, which outlives a synth's folder.
+class JobLock {
+ public:
+  explicit JobLock(const PlanJob& job) : file_(job.log_file.string() + ".lock") {
+    fs::create_directories(job.log_file.parent_path());
+    fd_ = ::open(file_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0) throw InputError(fmt::format("{}: cannot create the job's lock file", file_));
+    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+      ::close(fd_);
+      throw InputError(fmt::format("{} is running in another process ({} is held); let that one finish",
+                                   describe_job(job), file_));
+    }
+  }
+  ~JobLock() {
+    ::flock(fd_, LOCK_UN);
+    ::close(fd_);
+  }
+  JobLock(const JobLock&) = delete;
+  JobLock& operator=(const JobLock&) = delete;
+
+ private:
+  std::string file_;
+  int fd_ = -1;
+};
 
 // Before a job runs: nothing of an earlier attempt may pass for its result.
 void prepare_job(const BenchPlan& plan, const PlanJob& job, const SequenceSpec& seq) {
@@ -112,6 +142,7 @@ JobState job_state(const BenchPlan& plan, const PlanJob& job) {
 JobMarker run_bench_job(const BenchPlan& plan, std::size_t number, const std::function<void(const std::string&)>& log) {
   const PlanJob& job = plan.job(number);
   const SequenceSpec& seq = plan.sequence(job.sequence);
+  const JobLock lock(job);  // before the state is read: a job that another process just finished is not run again
   if (job_state(plan, job) == JobState::Complete) {
     log(fmt::format("bench: {} is complete already", describe_job(job)));
     auto m = read_job_marker(job);

@@ -118,6 +118,58 @@ std::string new_plan_id(const std::string& created_utc) {
   return fmt::format("{}-{}-{}", created_utc, ::getpid(), ns % 1000000000);
 }
 
+// Appends the job with its number, stage (one after the latest it needs) and scheduler resources.
+std::size_t add_job(BenchPlan& p, PlanJob job, double timeout_seconds) {
+  job.number = p.jobs.size();
+  job.timeout_seconds = timeout_seconds;
+  for (const auto n : job.needs) job.stage = std::max(job.stage, p.jobs[n].stage + 1);
+  set_resources(job, p.sequence(job.sequence), timeout_seconds);
+  p.jobs.push_back(std::move(job));
+  return p.jobs.back().number;
+}
+
+PlanJob synth_job(const BenchPlan& p, const SequenceSpec& seq, const fs::path& cache) {
+  PlanJob job;
+  job.kind = PlanJob::Kind::Synth;
+  job.sequence = seq.id;
+  job.argv = {p.executable.string()};
+  for (auto& a : synth_arguments(seq)) job.argv.push_back(std::move(a));
+  job.command = shell_join(job.argv);
+  job.out_dir = seq.dir;
+  job.log_file = cache / "logs" / (seq.id + ".synth.log");
+  return job;
+}
+
+PlanJob run_job(const BenchPlan& p, const BenchOptions& o, const SequenceSpec& seq, const BenchConfiguration& config,
+                const std::vector<std::size_t>& needs) {
+  PlanJob job;
+  job.kind = PlanJob::Kind::Run;
+  job.sequence = seq.id;
+  job.config = config.name;
+  fs::path boxes;
+  job.detector = detector_for(o, config, seq, boxes);
+  job.out_dir = p.dir / "runs" / seq.id / config.name;
+  job.argv = run_arguments(o, p.executable, seq, config, job.detector, boxes, job.out_dir);
+  job.command = shell_join(job.argv);
+  job.log_file = job.out_dir / "run.log";
+  job.needs = needs;
+  return job;
+}
+
+PlanJob peer_job(const BenchPlan& p, const std::string& peer_template, const SequenceSpec& seq,
+                 const std::vector<std::size_t>& needs) {
+  PlanJob job;
+  job.kind = PlanJob::Kind::Peer;
+  job.sequence = seq.id;
+  job.config = "peer";
+  job.out_dir = p.dir / "peer" / seq.id;
+  job.command = expand_peer_template(peer_template, seq, job.out_dir);
+  job.argv = {"/bin/sh", "-c", job.command};
+  job.log_file = job.out_dir / "peer.log";
+  job.needs = needs;
+  return job;
+}
+
 // ---- reading --------------------------------------------------------------------------------------------------
 
 // Where a key is read from, for error messages: "<file> line 3".
@@ -295,56 +347,14 @@ BenchPlan make_bench_plan(const BenchOptions& o) {
   p.peer_trajectory = o.peer_trajectory;
   p.sequences = plan_sequences(o, cache);
 
-  const auto add = [&p](PlanJob job, const SequenceSpec& seq, double timeout) -> std::size_t {
-    job.number = p.jobs.size();
-    job.sequence = seq.id;
-    job.timeout_seconds = timeout;
-    for (const auto n : job.needs) job.stage = std::max(job.stage, p.jobs[n].stage + 1);
-    set_resources(job, seq, timeout);
-    p.jobs.push_back(std::move(job));
-    return p.jobs.back().number;
-  };
   // Sequences first: every synth job is in stage 0, every job reading a sequence after it.
   std::vector<std::vector<std::size_t>> needs(p.sequences.size());
+  for (std::size_t si = 0; si < p.sequences.size(); ++si)
+    if (!p.sequences[si].real) needs[si] = {add_job(p, synth_job(p, p.sequences[si], cache), o.timeout_seconds)};
   for (std::size_t si = 0; si < p.sequences.size(); ++si) {
-    const SequenceSpec& seq = p.sequences[si];
-    if (seq.real) continue;
-    PlanJob job;
-    job.kind = PlanJob::Kind::Synth;
-    job.argv = {p.executable.string()};
-    for (auto& a : synth_arguments(seq)) job.argv.push_back(std::move(a));
-    job.command = shell_join(job.argv);
-    job.out_dir = seq.dir;
-    job.log_file = cache / "logs" / (seq.id + ".synth.log");
-    needs[si] = {add(std::move(job), seq, o.timeout_seconds)};
-  }
-  for (std::size_t si = 0; si < p.sequences.size(); ++si) {
-    const SequenceSpec& seq = p.sequences[si];
-    for (const auto& config_name : o.configs) {
-      const BenchConfiguration& config = configuration_by_name(config_name);
-      fs::path boxes;
-      PlanJob job;
-      job.kind = PlanJob::Kind::Run;
-      job.config = config_name;
-      job.detector = detector_for(o, config, seq, boxes);
-      job.out_dir = p.dir / "runs" / seq.id / config_name;
-      job.argv = run_arguments(o, p.executable, seq, config, job.detector, boxes, job.out_dir);
-      job.command = shell_join(job.argv);
-      job.log_file = job.out_dir / "run.log";
-      job.needs = needs[si];
-      add(std::move(job), seq, o.timeout_seconds);
-    }
-    if (p.peer) {
-      PlanJob job;
-      job.kind = PlanJob::Kind::Peer;
-      job.config = "peer";
-      job.out_dir = p.dir / "peer" / seq.id;
-      job.command = expand_peer_template(o.peer_template, seq, job.out_dir);
-      job.argv = {"/bin/sh", "-c", job.command};
-      job.log_file = job.out_dir / "peer.log";
-      job.needs = needs[si];
-      add(std::move(job), seq, o.timeout_seconds);
-    }
+    for (const auto& config : o.configs)
+      add_job(p, run_job(p, o, p.sequences[si], configuration_by_name(config), needs[si]), o.timeout_seconds);
+    if (p.peer) add_job(p, peer_job(p, o.peer_template, p.sequences[si], needs[si]), o.timeout_seconds);
   }
   return p;
 }

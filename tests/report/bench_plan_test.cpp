@@ -8,6 +8,8 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 #include <fstream>
 
@@ -203,6 +205,24 @@ TEST_F(BenchPlanTest, JobsRunOnceInOrderAndLeaveMarkers) {
   const BenchPlan again = planned();
   EXPECT_EQ(job_state(again, again.jobs[0]), JobState::Complete);
   EXPECT_EQ(job_state(again, again.jobs[1]), JobState::Missing);
+}
+
+TEST_F(BenchPlanTest, AJobRunningElsewhereIsNotStartedTwice) {
+  const BenchPlan p = planned();
+  const fs::path lock = p.jobs[0].log_file.string() + ".lock";
+  fs::create_directories(lock.parent_path());
+  const int fd = ::open(lock.c_str(), O_RDWR | O_CREAT, 0644);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);  // another executor's run-job of job 0
+  try {
+    run_bench_job(p, 0, quiet_);
+    ADD_FAILURE() << "a job whose lock is held must not run";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("job 0 (synth walking__camera_path__s1__2s__at4) is running in another process"));
+  }
+  EXPECT_FALSE(fs::exists(p.jobs[0].out_dir / "groundtruth.txt"));
+  ::close(fd);
+  EXPECT_TRUE(run_bench_job(p, 0, quiet_).ok);
 }
 
 TEST_F(BenchPlanTest, FailuresAreRecordedAndTheirDependentsSkipped) {
