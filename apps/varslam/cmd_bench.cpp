@@ -15,6 +15,7 @@
 #include "report/bench_collect.hpp"
 #include "report/bench_job.hpp"
 #include "report/bench_local_executor.hpp"
+#include "report/bench_plan_file.hpp"
 #include "report/bench_runner.hpp"
 #include "report/bench_slurm.hpp"
 #include "report/machine_info.hpp"

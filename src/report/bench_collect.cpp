@@ -11,6 +11,7 @@
 #include "io/output_folder.hpp"
 #include "io/trajectory_io.hpp"
 #include "report/bench_files.hpp"
+#include "report/bench_plan_file.hpp"
 #include "report/bench_summary.hpp"
 #include "report/machine_info.hpp"
 #include "report/run_report.hpp"

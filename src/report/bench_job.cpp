@@ -153,7 +153,7 @@ JobMarker run_bench_job(const BenchPlan& plan, std::size_t number, const std::fu
     const JobState s = job_state(plan, need);
     if (s == JobState::Failed) return record_failed_job(plan, job, kSkippedError);
     if (s == JobState::Missing)
-      throw InputError(fmt::format("{} needs {}, which has not run (or was stopped): run stage {} first", 
+      throw InputError(fmt::format("{} needs {}, which has not run (or was stopped): run stage {} first",
                                    describe_job(job), describe_job(need), need.stage));
   }
   prepare_job(plan, job, seq);

@@ -1,17 +1,15 @@
 #pragma once
-// A benchmark as a plan of independent jobs, written to <out>/plan.jsonl (format: docs/bench_plan.md), so that
-// any executor (the built-in process pool, GNU parallel, xargs, a Slurm job array) can run the jobs and
-// `varslam bench collect` can gather whatever finished. Planning decides and writes; it runs nothing.
+// A benchmark as a plan of independent jobs (written to <out>/plan.jsonl by bench_plan_file), so that any
+// executor (the built-in process pool, GNU parallel, xargs, a Slurm job array) can run the jobs and
+// `varslam bench collect` can gather whatever finished. Planning decides; it runs nothing.
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
-#include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
-#include "io/output_folder.hpp"
 #include "report/bench_matrix.hpp"
 
 namespace varslam::report {
@@ -43,9 +41,7 @@ struct BenchOptions {
   std::string command_line;                // how the benchmark was invoked (recorded)
 };
 
-/// The plan file's format name and version; a reader refuses any other version.
-inline constexpr const char* kBenchPlanFormat = "varslam bench plan";
-inline constexpr int kBenchPlanVersion = 1;
+/// The plan's file in its folder (format: bench_plan_file.hpp, docs/bench_plan.md).
 inline constexpr const char* kBenchPlanFile = "plan.jsonl";
 
 /// One job: one child process with its output folder, what it needs first, and what a scheduler should grant it.
@@ -95,26 +91,8 @@ struct BenchPlan {
 /// Throws InputError on bad options.
 BenchPlan make_bench_plan(const BenchOptions& options);
 
-/// Claims the plan folder for the benchmark's own files (plan.jsonl, results.json, table.md, index.html) before
-/// anything else is checked: a folder holding the user's files of those names is refused (InputError naming them),
-/// and a second benchmark into it is refused while the returned folder is held.
-std::unique_ptr<OutputFolder> claim_bench_folder(const std::filesystem::path& out);
-
-/// Removes the outputs and completion markers of earlier runs into the plan's run folders, invalidates the plan's
-/// cached sequences when `fresh_sequences`, and writes plan.jsonl (into a folder claim_bench_folder claimed).
-void write_bench_plan(const BenchPlan& plan, bool fresh_sequences);
-
-/// Reads <dir>/plan.jsonl; InputError naming the folder, file, line or key on anything wrong (no folder, no plan,
-/// another format version, a missing key, jobs out of order, a dependency on a later job).
-BenchPlan read_bench_plan(const std::filesystem::path& dir);
-
 /// The plan's jobs of one stage, in order (an executor runs stage 0 before stage 1).
 std::vector<std::size_t> jobs_of_stage(const BenchPlan& plan, int stage);
 int stage_count(const BenchPlan& plan);
-
-nlohmann::json to_json(const PlanJob& job);
-/// The job as its plan line: the keys in the order docs/bench_plan.md lists them.
-nlohmann::ordered_json job_line(const PlanJob& job);
-nlohmann::json to_json(const SequenceSpec& seq);
 
 }  // namespace varslam::report

@@ -5,6 +5,7 @@
 // separate commands, so that other executors (GNU parallel, xargs, Slurm) can run the same plan.
 #include "report/bench_collect.hpp"
 #include "report/bench_plan.hpp"
+#include "report/bench_plan_file.hpp"
 
 namespace varslam::report {
 

@@ -17,6 +17,7 @@
 #include "io/trajectory_io.hpp"
 #include "report/bench_collect.hpp"
 #include "report/bench_job.hpp"
+#include "report/bench_plan_file.hpp"
 #include "report/bench_slurm.hpp"
 
 namespace varslam::report {
