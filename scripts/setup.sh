@@ -11,7 +11,10 @@ PKGS=(build-essential cmake pkg-config ccache libopencv-dev libeigen3-dev libcer
       librcpputils-dev librcutils-dev libament-index-cpp-dev libmessage-filters-dev libcv-bridge-dev libtf2-ros-dev
       ros-core
       python3-rosbag python3-sensor-msgs
-      python3-geometry-msgs python3-nav-msgs python3-tf2-msgs python3-std-srvs curl)
+      python3-geometry-msgs python3-nav-msgs python3-tf2-msgs python3-std-srvs curl
+      # Executors of a benchmark plan that the tests run it with: GNU parallel, and a one-node Slurm cluster
+      # (slurmctld + slurmd + munged, started by tests/report/slurm_one_node.sh, never as system services).
+      parallel slurm-wlm munge)
 # The viewer's build installs three.js with npm; a machine that has node and npm from elsewhere keeps them.
 if ! command -v npm >/dev/null 2>&1; then PKGS+=(nodejs npm); fi
 missing=()

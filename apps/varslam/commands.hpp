@@ -10,7 +10,8 @@ struct CommandFailed : std::runtime_error {
   CommandFailed(const std::string& what, int exit_code) : std::runtime_error(what), code(exit_code) {}
   int code;
 };
-inline constexpr int kExitInputError = 2, kExitInternalError = 3, kExitTrackingFailed = 4, kExitInterrupted = 130;
+inline constexpr int kExitInputError = 2, kExitInternalError = 3, kExitTrackingFailed = 4, kExitIncomplete = 5,
+                     kExitInterrupted = 130;  // kExitIncomplete: bench collect with jobs missing
 
 void add_run_command(CLI::App& app);
 void add_eval_command(CLI::App& app);

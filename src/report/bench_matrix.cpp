@@ -9,7 +9,7 @@
 
 #include "core/error.hpp"
 #include "io/trajectory_io.hpp"
-#include "report/bench_runner.hpp"
+#include "report/bench_plan.hpp"
 #include "synth/synth.hpp"
 
 namespace varslam::report {

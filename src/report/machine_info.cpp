@@ -39,6 +39,17 @@ nlohmann::json to_json(const MachineInfo& m) {
           {"load_average_1min", m.load_average}, {"os", m.os}};
 }
 
+MachineInfo machine_info_from_json(const nlohmann::json& j) {
+  MachineInfo m;
+  if (!j.is_object()) return m;
+  m.cores = j.value("nproc", 0u);
+  m.cpu_model = j.value("cpu_model", std::string());
+  m.memory_gb = j.value("memory_gb", 0.0);
+  m.load_average = j.value("load_average_1min", 0.0);
+  m.os = j.value("os", std::string());
+  return m;
+}
+
 std::string describe(const MachineInfo& m) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.1f GB RAM", m.memory_gb);

@@ -15,6 +15,8 @@ struct MachineInfo {
 };
 MachineInfo sample_machine_info();
 nlohmann::json to_json(const MachineInfo& m);
+/// Back from to_json (a benchmark plan records where it was planned); missing keys stay empty.
+MachineInfo machine_info_from_json(const nlohmann::json& j);
 /// "2 cores, Intel(R) Xeon(R) ..., 7.8 GB" style line.
 std::string describe(const MachineInfo& m);
 
