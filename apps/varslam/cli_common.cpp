@@ -138,10 +138,11 @@ void print_run_summary(const run::RunSummary& s) {
   }
   if (s.metrics.contains("realtime")) {
     const auto& r = s.metrics["realtime"];
-    fmt::print("real time        latency median {:.1f} ms, p95 {:.1f} (frame in to pose out); {} frame(s) dropped; "
-               "mapping queue median {:.0f}, max {:.0f}; Local BA skipped on {} and cut short on {} of {} keyframes\n",
+    fmt::print("real time        latency median {:.1f} ms, p95 {:.1f} (frame in to pose out); frames late {}, dropped {} "
+               "(a newer one had arrived); mapping queue median {:.0f}, max {:.0f}; Local BA skipped on {} and cut "
+               "short on {} of {} keyframes\n",
                r["latency"]["median_ms"].get<double>(), r["latency"]["p95_ms"].get<double>(),
-               r["dropped_frames"].get<long>(), r["mapping_queue"]["median"].get<double>(),
+               r["late_frames"].get<long>(), r["dropped_frames"].get<long>(), r["mapping_queue"]["median"].get<double>(),
                r["mapping_queue"]["max"].get<double>(), r["local_ba_skipped"].get<long>(),
                r["local_ba_cut_short"].get<long>(), r["keyframes_mapped"].get<long>());
   }

@@ -23,6 +23,7 @@ struct FlagNeed {
 // Every such pair of every subcommand, checked in one place (check_flag_needs).
 inline constexpr FlagNeed kFlagNeeds[] = {
     {"run", "--pace", "--realtime", "feeds frames at the dataset's rate in real-time mode"},
+    {"run", "--drop-late", "--pace", "drops frames a newer one has overtaken, as a live sensor does"},
     {"run", "--viewer-port", "--viewer", "sets the live viewer's port"},
     {"run", "--viewer-address", "--viewer", "sets the live viewer's address"},
     {"run", "--viewer-fps", "--viewer", "limits the frames sent to the live viewer"},

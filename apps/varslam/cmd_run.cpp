@@ -46,7 +46,7 @@ void add_run_command(CLI::App& app) {
   struct Opts {
     std::string dataset, settings, out = "out/run", groundtruth, save_map, load_map;
     bag::BagTopics topics;
-    bool realtime = false, pace = false, quiet = false, localization_only = false;
+    bool realtime = false, pace = false, drop_late = false, quiet = false, localization_only = false;
     bool viewer = false, viewer_hold = false, viewer_wait = false;
     std::string viewer_address = "127.0.0.1";
     int viewer_port = 0;
@@ -73,6 +73,9 @@ void add_run_command(CLI::App& app) {
       ->check(kNonEmptyPath);
   cmd->add_flag("--realtime", o->realtime, "Real-time mode: local mapping on its own thread");
   cmd->add_flag("--pace", o->pace, "With --realtime: feed frames at the dataset's frame rate");
+  cmd->add_flag("--drop-late", o->drop_late,
+                "With --pace: drop a frame when tracking is free only after the next one has arrived, as a live "
+                "sensor does (without it such frames are tracked late and counted)");
   cmd->add_option("--first", o->first, "First frame index")->check(kFrameIndex);
   cmd->add_option("--max-frames,-n", o->max_frames, "Process at most this many frames")->check(kFrameCount);
   cmd->add_option("--min-tracked-share", o->min_tracked_share,
@@ -120,6 +123,7 @@ void add_run_command(CLI::App& app) {
     run::RunOptions ro;
     ro.mode = o->realtime ? RunMode::RealTime : RunMode::Deterministic;
     ro.pace = o->pace;
+    ro.drop_late = o->drop_late;
     ro.first = o->first;
     ro.max_frames = o->max_frames;
     ro.progress = !o->quiet;

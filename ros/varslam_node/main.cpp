@@ -1,9 +1,13 @@
 // varslam_node: varslam as a ROS 1 node (node.hpp). Bad parameters stop it with the message and exit code 2.
+#include <cstdio>
 #include <ros/ros.h>
 
 #include "node.hpp"
 
 int main(int argc, char** argv) {
+  // rosconsole writes INFO lines to stdout; redirected to a file (roslaunch, a service manager) stdout is fully
+  // buffered, and a user tailing the log would see nothing until the node exits. One line at a time instead.
+  std::setvbuf(stdout, nullptr, _IOLBF, BUFSIZ);
   ros::init(argc, argv, "varslam");
   ros::NodeHandle nh, pnh("~");
   // varslam's own log lines go through rosconsole, with the node's.

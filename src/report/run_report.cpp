@@ -104,7 +104,9 @@ std::string key_numbers_table(const nlohmann::json& m) {
     t += row("latency median / p95 (frame in to pose out)",
              format_number(json_number(m, {"realtime", "latency", "median_ms"}), 1) + " / " +
                  format_number(json_number(m, {"realtime", "latency", "p95_ms"}), 1) + " ms");
-    t += row("frames dropped (a newer one had arrived)", format_number(json_number(m, {"realtime", "dropped_frames"}), 0));
+    t += row("frames late / dropped (a newer one had arrived)",
+             format_number(json_number(m, {"realtime", "late_frames"}), 0) + " / " +
+                 format_number(json_number(m, {"realtime", "dropped_frames"}), 0));
     t += row("mapping queue median / max", format_number(json_number(m, {"realtime", "mapping_queue", "median"}), 0) +
                                                " / " + format_number(json_number(m, {"realtime", "mapping_queue", "max"}), 0));
     t += row("Local BA skipped / cut short", format_number(json_number(m, {"realtime", "local_ba_skipped"}), 0) + " / " +

@@ -222,12 +222,12 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const RunO
     if (n == 0) first_stamp = frame->timestamp;
     Clock::time_point arrival = Clock::now();
     if (paced) {
-      // As a sensor delivers: the frame arrives at its time; when tracking is free only after the next frame has
-      // arrived too, this one is dropped (a camera driver keeps the newest frame).
+      // As a sensor delivers: the frame arrives at its time. When tracking is free only after the next frame has
+      // arrived too, this one is late: a live camera driver would have dropped it for the newer one.
       const auto next = std::upper_bound(stamps.begin(), stamps.end(), frame->timestamp);
       if (n > 0 && next != stamps.end() && Clock::now() >= due(*next)) {
-        metrics.add_dropped_frame();
-        continue;
+        metrics.add_late_frame(options.drop_late);
+        if (options.drop_late) continue;
       }
       arrival = due(frame->timestamp);
       std::this_thread::sleep_until(arrival);

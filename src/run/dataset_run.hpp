@@ -18,6 +18,7 @@ namespace varslam::run {
 struct RunOptions {
   RunMode mode = RunMode::Deterministic;
   bool pace = false;           // real-time mode: feed frames at the dataset's frame rate (else as fast as possible)
+  bool drop_late = false;      // paced: drop a frame a newer one has overtaken (else track it late and count it)
   std::size_t first = 0;       // first frame index
   std::size_t max_frames = SIZE_MAX;
   bool progress = true;        // progress line on stderr

@@ -110,6 +110,7 @@ nlohmann::json MetricsRecorder::metrics(const Pipeline& slam) const {
     const auto queue = median_p95(mapping_queue_);
     m["realtime"] = {
         {"dropped_frames", dropped_frames_},
+        {"late_frames", late_frames_},
         {"latency", timing_json(latency_ms_)},
         {"mapping_queue", {{"median", queue.first}, {"p95", queue.second},
                            {"max", mapping_queue_.empty() ? 0.0 : *std::max_element(mapping_queue_.begin(), mapping_queue_.end())}}},

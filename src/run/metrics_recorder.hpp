@@ -18,8 +18,9 @@ class MetricsRecorder final : public Observer {
   void add_load_ms(double ms) { load_ms_.push_back(ms); }
   /// Real time: from the frame's arrival (its due time when paced, else the call) to its pose.
   void add_latency_ms(double ms) { latency_ms_.push_back(ms); }
-  /// Real time, paced: a frame not tracked because a newer one was already due when tracking was free.
-  void add_dropped_frame() { ++dropped_frames_; }
+  /// Real time, paced: a newer frame had already arrived when tracking was free for this one; `dropped`: it was
+  /// not tracked (--drop-late), else it was tracked late.
+  void add_late_frame(bool dropped) { ++(dropped ? dropped_frames_ : late_frames_); }
 
   void on_depth_registration(const DepthRegistrationEvent& e) override;
   void on_frame(const FrameResult& f) override;
@@ -50,7 +51,7 @@ class MetricsRecorder final : public Observer {
   long frames_without_boxes_ = 0;
   std::vector<double> box_age_ms_, detector_latency_ms_, dropped_;
   std::vector<double> latency_ms_, mapping_queue_;
-  long dropped_frames_ = 0, ba_skipped_ = 0, ba_cut_short_ = 0, keyframes_mapped_ = 0;
+  long dropped_frames_ = 0, late_frames_ = 0, ba_skipped_ = 0, ba_cut_short_ = 0, keyframes_mapped_ = 0;
 };
 
 }  // namespace varslam::run

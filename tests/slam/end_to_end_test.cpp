@@ -101,13 +101,14 @@ TEST(EndToEnd, RealTimeModeTracksTheSameSequence) {
   EXPECT_LT(*s.ate_rmse, 0.03);
 }
 
-// Paced real time reports what a robot would see: every frame either tracked (with its latency) or dropped because
-// a newer one had arrived, the mapping queue, and which keyframes' Local BA was skipped or cut short.
+// Paced real time with --drop-late reports what a robot would see: every frame either tracked (with its latency) or
+// dropped because a newer one had arrived, the mapping queue, and which keyframes' Local BA was skipped or cut short.
 TEST(EndToEnd, PacedRealTimeAccountsForEveryFrameAndReportsLatency) {
   const fs::path seq = static_sequence();
   run::RunOptions ro;
   ro.mode = RunMode::RealTime;
   ro.pace = true;
+  ro.drop_late = true;
   ro.progress = false;
   const RunSummary s = e2e::run_with(seq, test_dir("rt_paced"), ro);
   const auto& m = s.metrics;
@@ -115,6 +116,7 @@ TEST(EndToEnd, PacedRealTimeAccountsForEveryFrameAndReportsLatency) {
   const auto& r = m["realtime"];
   const std::size_t total = open_dataset(seq, settings_for_dataset(seq, std::nullopt))->size();
   EXPECT_EQ(s.frames + r["dropped_frames"].get<std::size_t>(), total);
+  EXPECT_EQ(r["late_frames"].get<long>(), 0);  // with --drop-late a late frame is dropped, not tracked late
   EXPECT_EQ(r["latency"]["count"].get<std::size_t>(), s.frames);
   EXPECT_GT(r["latency"]["median_ms"].get<double>(), 0.0);
   EXPECT_GE(r["latency"]["p95_ms"].get<double>(), r["latency"]["median_ms"].get<double>());
