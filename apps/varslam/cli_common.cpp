@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include "cli_common.hpp"
 
@@ -135,6 +136,16 @@ void print_run_summary(const run::RunSummary& s) {
                t["tracking"]["median_ms"].get<double>(), t["extract"]["median_ms"].get<double>(),
                t["match"]["median_ms"].get<double>(), t["pose_optimization"]["median_ms"].get<double>(),
                t["local_ba"]["median_ms"].get<double>());
+  }
+  // Deterministic mode runs the detector in line on every frame: on a slow machine that, not SLAM, sets the speed.
+  // Say so, and what runs faster, where a user would otherwise wonder.
+  if (s.metrics.value("mode", "") == "deterministic" && s.metrics.contains("semantic") && s.fps < 20.0 &&
+      s.metrics["semantic"].value("detector_runs", 0) > 0) {
+    const double detector_ms = s.metrics["semantic"]["detector_latency"]["median_ms"].get<double>();
+    if (detector_ms > 0.5 * 1000.0 / std::max(s.fps, 1e-9))
+      fmt::print("note             the person detector took {:.0f} ms per frame, in line (deterministic mode); "
+                 "--realtime runs it beside tracking\n",
+                 detector_ms);
   }
   if (s.metrics.contains("realtime")) {
     const auto& r = s.metrics["realtime"];
