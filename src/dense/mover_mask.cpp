@@ -20,7 +20,9 @@ cv::Mat mover_mask(const cv::Mat& depth, const MoverMaskInputs& in) {
     }
   };
   for (const PersonBand& p : in.people) {
-    if (p.depth_m > 0) mark_band(p.rect, p.depth_m - p.band_m, p.depth_m + p.band_m, true);
+    // Everything up to the far end of the person's band: a person's depth taken from the wrong histogram mode (a
+    // small or half-hidden person, the room behind them) still leaves the person out; the room behind stays.
+    if (p.depth_m > 0) mark_band(p.rect, 0.0f, p.depth_m + p.band_m, true);
     else mask(p.rect & image).setTo(255);
   }
   for (const NearMoverBand& n : in.near_movers) {

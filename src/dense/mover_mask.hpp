@@ -1,7 +1,8 @@
 #pragma once
 // Which pixels of a keyframe the dense map must not build surface from: everything the system knows moved.
-//  - people: inside each (enlarged) person box, the pixels at the person's depth (within the person filter's band) and
-//    those without depth; a box whose person depth is unknown is left out whole;
+//  - people: inside each (enlarged) person box, the pixels up to the far end of the person's depth band (the person
+//    filter's band: a wrong depth mode then still covers the person) and those without depth; a box whose person
+//    depth is unknown is left out whole;
 //  - the near mover tracking follows (a carried box): its image region grown by a margin, at its depth band;
 //  - keypoints flagged moving (on the near mover, or outliers of the pose solve): a disc around each at its depth;
 //  - the caller's own mover mask.
@@ -15,7 +16,7 @@ namespace varslam::dense {
 struct PersonBand {
   cv::Rect rect;            // enlarged box, clipped to the image
   float depth_m = 0;        // 0 = unknown
-  float band_m = 0.5f;      // pixels within +-band of depth_m are the person
+  float band_m = 0.5f;      // pixels nearer than depth_m + band_m are left out
 };
 
 struct NearMoverBand {

@@ -198,7 +198,7 @@ void Pipeline::start(std::span<const RgbdFrame> samples) {
   }
   system_->set_localization_only(localization_only_);
   if (dense_cfg_->enabled)
-    dense_ = std::make_unique<dense::DenseMapper>(*dense_cfg_, settings_.camera, options_.mode == RunMode::RealTime);
+    dense_ = std::make_shared<dense::DenseMapper>(*dense_cfg_, settings_.camera, options_.mode == RunMode::RealTime);
   if (pending_pose_hint_) system_->set_pose_hint(pending_pose_hint_->first, pending_pose_hint_->second);
   pending_pose_hint_.reset();
   if (masker_) install_person_filter();

@@ -126,6 +126,7 @@ class Pipeline {
   /// The dense map of the static scene (dense.enabled), null when off or before the first frame. Final after
   /// finish(); its mesh()/occupancy()/stats() may be read from any thread.
   dense::DenseMapper* dense_map() const { return dense_.get(); }
+  std::shared_ptr<dense::DenseMapper> shared_dense_map() const { return dense_; }
 
   const Settings& settings() const { return settings_; }  // camera = the colour camera after registration
   const slam::SlamConfig& config() const { return cfg_; }
@@ -150,7 +151,7 @@ class Pipeline {
   std::optional<DetectionEvent> detection_;  // of the frame being tracked, handed out after it
   std::unique_ptr<slam::System> system_;     // built by start(), once the colour camera is known
   std::unique_ptr<dense::DenseConfig> dense_cfg_;
-  std::unique_ptr<dense::DenseMapper> dense_;  // dense.enabled: built by start() (it needs the colour camera)
+  std::shared_ptr<dense::DenseMapper> dense_;  // dense.enabled: built by start() (it needs the colour camera)
   void give_dense_keyframe(const RgbdFrame& frame, const slam::TrackOutcome& out);
   const slam::Map empty_map_;               // what map() shows before the first frame
   Trajectory live_;

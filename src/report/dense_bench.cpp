@@ -117,6 +117,47 @@ nlohmann::json DenseScores::to_json() const {
           {"ghost_vertex_share", ghost_vertex_share}};
 }
 
+std::vector<double> nearest_vertex_distances(const std::vector<Eigen::Vector3f>& from,
+                                             const std::vector<Eigen::Vector3f>& to) {
+  const VertexGrid grid(to);
+  std::vector<double> d(from.size());
+  for (std::size_t i = 0; i < from.size(); ++i) d[i] = grid.nearest(from[i].cast<double>());
+  return d;
+}
+
+nlohmann::json MeshComparison::to_json() const {
+  return {{"vertices", vertices},
+          {"reference_vertices", reference_vertices},
+          {"accuracy_mean_cm", accuracy_mean_cm},
+          {"accuracy_median_cm", accuracy_median_cm},
+          {"accuracy_within_2cm", accuracy_within},
+          {"completeness_within_2cm", completeness_within}};
+}
+
+MeshComparison compare_meshes(const std::vector<Eigen::Vector3f>& mesh, const std::vector<Eigen::Vector3f>& reference,
+                              double within_m) {
+  MeshComparison c;
+  c.vertices = mesh.size();
+  c.reference_vertices = reference.size();
+  const std::vector<double> a = nearest_vertex_distances(mesh, reference);
+  const std::vector<double> b = nearest_vertex_distances(reference, mesh);
+  double sum = 0;
+  std::size_t in = 0;
+  for (const double x : a) {
+    sum += x;
+    in += x <= within_m ? 1 : 0;
+  }
+  if (!a.empty()) {
+    c.accuracy_mean_cm = 100.0 * sum / static_cast<double>(a.size());
+    c.accuracy_median_cm = 100.0 * median(a);
+    c.accuracy_within = static_cast<double>(in) / static_cast<double>(a.size());
+  }
+  std::size_t cov = 0;
+  for (const double x : b) cov += x <= within_m ? 1 : 0;
+  if (!b.empty()) c.completeness_within = static_cast<double>(cov) / static_cast<double>(b.size());
+  return c;
+}
+
 DenseScores score_dense_map(const synth::World& world, const PinholeCamera& camera, const dense::Mesh& mesh,
                             const std::vector<dense::OccupancyVoxel>& occupancy, const DenseTruthOptions& opt) {
   DenseScores s;

@@ -41,6 +41,20 @@ double distance_to_static(const synth::Scene& scene, const Eigen::Vector3d& p);
 /// True when p lies inside the primitive.
 bool inside(const synth::Primitive& prim, const Eigen::Vector3d& p);
 
+/// For each point of `from`, the distance (m) to the nearest vertex of `to`, capped at 5 cm.
+std::vector<double> nearest_vertex_distances(const std::vector<Eigen::Vector3f>& from,
+                                             const std::vector<Eigen::Vector3f>& to);
+
+/// Two meshes of one scene compared vertex to vertex (a SLAM mesh against one fused from ground-truth poses).
+struct MeshComparison {
+  double accuracy_mean_cm = 0, accuracy_median_cm = 0, accuracy_within = 0;  // mesh -> reference, capped at 5 cm
+  double completeness_within = 0;                                            // reference -> mesh
+  std::size_t vertices = 0, reference_vertices = 0;
+  nlohmann::json to_json() const;
+};
+MeshComparison compare_meshes(const std::vector<Eigen::Vector3f>& mesh, const std::vector<Eigen::Vector3f>& reference,
+                              double within_m = 0.02);
+
 DenseScores score_dense_map(const synth::World& world, const PinholeCamera& camera, const dense::Mesh& mesh,
                             const std::vector<dense::OccupancyVoxel>& occupancy, const DenseTruthOptions& opt);
 
