@@ -225,6 +225,7 @@ inline constexpr KeySpec kKeys[] = {
     detail::integer("dense.min_weight", 1, 1, 1000, "observations a voxel needs to be part of the mesh and the occupancy map"),
     detail::integer("dense.pixel_step", 2, 1, 16, "fuse every n-th pixel of a keyframe in each direction (the keyframe store shrinks by its square)"),
     detail::flag("dense.clear_free_space", true, "space a depth pixel sees through (beyond the truncation in front of its surface) is voted free, so a mover fused once and seen through later is removed"),
+    detail::integer("dense.keep_free_votes", 2, 0, 1000, "a voxel seen only as free space at least this many times stays free when a surface shows up in it (a mover no filter knew walked in); 0 = off"),
     detail::flag("dense.exclude_movers", true, "leave out the pixels the system knows moved: people at their depth band, the near mover followed, keypoints flagged moving, the caller's mover mask (false: fuse every pixel)"),
     detail::real("dense.moving_point_radius_px", 12.0, 0.0, 200.0, "radius (pixels) of the disc left out around a keypoint flagged moving (at its depth)"),
     detail::integer("dense.mover_margin_px", 3, 0, 100, "the mover mask grows by this many pixels (the mixed depths at a mover's outline)"),

@@ -10,6 +10,8 @@
 #include <octomap/OcTree.h>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
+#include <pthread.h>
+#include <sched.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -28,6 +30,7 @@ DenseConfig dense_config(const Settings& s) {
   c.tsdf.max_range = setting<double>(s, "dense.max_range");
   c.tsdf.min_weight = setting<int>(s, "dense.min_weight");
   c.tsdf.carve = setting<bool>(s, "dense.clear_free_space");
+  c.tsdf.keep_free_votes = setting<int>(s, "dense.keep_free_votes");
   c.pixel_step = setting<int>(s, "dense.pixel_step");
   c.exclude_movers = setting<bool>(s, "dense.exclude_movers");
   c.point_radius_px = static_cast<float>(setting<double>(s, "dense.moving_point_radius_px"));
@@ -183,8 +186,11 @@ void DenseMapper::rebuild_locked() {
 }
 
 void DenseMapper::worker() {
-  // Below tracking and local mapping: on a busy machine the dense map waits, not the pose.
-  setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), 10);
+  // Below tracking and local mapping: the dense map runs only on a core nothing else wants (SCHED_IDLE; else at nice
+  // +10). On a busy machine it waits, not the pose; finish() fuses what is left.
+  sched_param idle{};
+  if (pthread_setschedparam(pthread_self(), SCHED_IDLE, &idle) != 0)
+    setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), 10);
   std::unique_lock lock(mutex_);
   while (!stop_) {
     if (!pending_.empty()) {

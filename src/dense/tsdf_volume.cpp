@@ -106,6 +106,7 @@ IntegrationStats TsdfVolume::integrate(const DepthView& view, int sign) {
   const auto fx = static_cast<float>(cam.fx), fy = static_cast<float>(cam.fy), cx = static_cast<float>(cam.cx),
              cy = static_cast<float>(cam.cy);
   const auto trunc_f = static_cast<float>(trunc), sgn = static_cast<float>(sign);
+  const auto keep_free = static_cast<float>(cfg_.carve ? cfg_.keep_free_votes : 0);
   for (auto& [k, block] : blocks_) {
     const Eigen::Vector3i b = unkey(k);
     const Eigen::Vector3d centre = (b.cast<double>() + Eigen::Vector3d::Constant(0.5)) * block_m;
@@ -140,6 +141,15 @@ IntegrationStats TsdfVolume::integrate(const DepthView& view, int sign) {
             ++st.voxels_carved;
           } else {
             if (have_movers && view.movers.at<std::uint8_t>(vi, ui)) continue;
+            // Space seen empty again and again that now shows a surface: something moved into it (a mover no filter
+            // knew). It adds one more free observation instead; a static surface is never seen through like that.
+            if (keep_free > 0 && sign > 0 && vox.weight >= keep_free && vox.sdf_sum >= vox.weight - 1e-3f) {
+              vox.sdf_sum += 1.0f;
+              vox.weight += 1.0f;
+              ++st.voxels_kept_free;
+              touched = true;
+              continue;
+            }
             vox.sdf_sum += sgn * (sdf / trunc_f);
             vox.weight += sgn;
             if (have_colour) {

@@ -25,6 +25,9 @@ struct TsdfConfig {
   double min_range = 0.2, max_range = 4.0;  // metres along the optical axis; depth outside is not used
   int min_weight = 1;              // observations a voxel needs to count (mesh, occupancy)
   bool carve = true;               // free-space observations in front of the measured surface
+  // A voxel seen only as free space at least this many times stays free when a surface appears in it (something
+  // moved in); 0 = off.
+  int keep_free_votes = 2;
   double truncation() const { return truncation_voxels * voxel_size; }
 };
 
@@ -58,7 +61,8 @@ struct OccupancyVoxel {
 };
 
 struct IntegrationStats {
-  std::size_t blocks_touched = 0, voxels_updated = 0, voxels_carved = 0, pixels_used = 0, pixels_moving = 0;
+  std::size_t blocks_touched = 0, voxels_updated = 0, voxels_carved = 0, voxels_kept_free = 0, pixels_used = 0,
+              pixels_moving = 0;
 };
 
 class TsdfVolume {
