@@ -130,8 +130,12 @@ IntegrationStats TsdfVolume::integrate(const DepthView& view, int sign) {
           const int ui = static_cast<int>(std::lround(uf)), vi = static_cast<int>(std::lround(vf));
           if (ui < 0 || vi < 0 || ui >= view.depth.cols || vi >= view.depth.rows) continue;
           const float d = view.depth.at<float>(vi, ui);
-          if (!(d >= min_r && d <= max_r)) continue;
+          if (!(d >= min_r)) continue;
+          // Beyond the range the surface is not fused, but the ray still shows the space before it empty (up to the
+          // range): a mover seen against a far wall is cleared by the frames that see the wall again.
+          const bool far = d > max_r;
           const float sdf = d - pc.z();
+          if (far && (pc.z() > max_r || sdf <= trunc_f)) continue;
           if (sdf < -trunc_f) continue;
           Voxel& vox = block.v[local_index(x, y, z)];
           if (sdf > trunc_f) {

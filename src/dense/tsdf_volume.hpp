@@ -22,7 +22,9 @@ namespace varslam::dense {
 struct TsdfConfig {
   double voxel_size = 0.02;        // metres
   double truncation_voxels = 4.0;  // the truncation distance in voxels
-  double min_range = 0.2, max_range = 4.0;  // metres along the optical axis; depth outside is not used
+  // Metres along the optical axis: depth outside adds no surface; depth beyond max_range still clears the space
+  // up to max_range.
+  double min_range = 0.2, max_range = 4.0;
   int min_weight = 1;              // observations a voxel needs to count (mesh, occupancy)
   bool carve = true;               // free-space observations in front of the measured surface
   // A voxel seen only as free space at least this many times stays free when a surface appears in it (something

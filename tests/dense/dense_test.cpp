@@ -100,6 +100,18 @@ TEST(Tsdf, AMoverFusedOnceIsClearedWhenLaterViewsSeeThroughIt) {
   EXPECT_GT(vertices_near_z(kept.extract_mesh(), 1.0f), 100u);
 }
 
+TEST(Tsdf, AWallBeyondTheRangeStillClearsTheSpaceInFrontOfIt) {
+  const PinholeCamera c = small_camera();
+  const cv::Rect box(60, 40, 40, 40);
+  TsdfVolume vol(TsdfConfig{});  // max_range 4 m
+  vol.integrate(view(c, wall_depth(c, 6.0f, 1.0f, box)));
+  ASSERT_GT(vertices_near_z(vol.extract_mesh(), 1.0f), 100u);
+  for (int i = 0; i < 2; ++i) vol.integrate(view(c, wall_depth(c, 6.0f)));
+  const Mesh m = vol.extract_mesh();
+  EXPECT_EQ(vertices_near_z(m, 1.0f), 0u);
+  for (const auto& v : m.vertices) EXPECT_LT(v.z(), 4.1f);  // nothing of the far wall itself
+}
+
 TEST(Tsdf, TakingAViewOutLeavesNothingBehind) {
   const PinholeCamera c = small_camera();
   TsdfVolume vol(TsdfConfig{});
