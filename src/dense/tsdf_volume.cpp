@@ -125,7 +125,7 @@ IntegrationStats TsdfVolume::integrate(const DepthView& view, int sign) {
           const Eigen::Vector3f pw = ((b * kB + Eigen::Vector3i(x, y, z)).cast<float>() + Eigen::Vector3f::Constant(0.5f)) *
                                      static_cast<float>(vs);
           const Eigen::Vector3f pc = Rcw * pw + tcw;
-          if (pc.z() <= 0.0f) continue;
+          if (pc.z() < 0.05f) continue;  // at the lens: nothing to fuse (and no overflow in the projection)
           const float uf = fx * pc.x() / pc.z() + cx, vf = fy * pc.y() / pc.z() + cy;
           const int ui = static_cast<int>(std::lround(uf)), vi = static_cast<int>(std::lround(vf));
           if (ui < 0 || vi < 0 || ui >= view.depth.cols || vi >= view.depth.rows) continue;
