@@ -182,7 +182,8 @@ TEST(ApiSlam, TheDenseMapIsASnapshotAnyThreadMayRead) {
   reader.join();
   EXPECT_GT(reads, 2u);
   const auto d = slam.dense_map_snapshot();
-  EXPECT_EQ(d->keyframes, slam.summary().keyframes);
+  EXPECT_GE(d->keyframes, slam.summary().keyframes);  // culled keyframes stay in the dense map (at their parent's pose)
+  EXPECT_GT(d->keyframes, 2u);
   EXPECT_DOUBLE_EQ(d->voxel_size, 0.02);
   EXPECT_GT(d->vertices.size(), 5000u);
   EXPECT_EQ(d->colours.size(), d->vertices.size());
