@@ -24,7 +24,7 @@ if setarch "$(uname -m)" -R true 2>/dev/null; then norandom=(setarch "$(uname -m
 echo "[sanitize] AddressSanitizer + UndefinedBehaviorSanitizer"
 configure build-asan "-fsanitize=address,undefined -fno-sanitize-recover=undefined"
 asan_tests=(test_core test_robust test_io test_features test_optim test_semantic test_slam test_pipeline test_eval test_viewer
-  test_api test_bag)
+  test_api test_bag test_dense)
 cmake --build build-asan -j"$JOBS" --target "${asan_tests[@]}"
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=0:halt_on_error=1"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
@@ -39,12 +39,14 @@ done
 
 echo "[sanitize] ThreadSanitizer"
 configure build-tsan "-fsanitize=thread"
-cmake --build build-tsan -j"$JOBS" --target test_pipeline test_slam test_semantic test_viewer test_api
+cmake --build build-tsan -j"$JOBS" --target test_pipeline test_slam test_semantic test_viewer test_api test_dense
 export TSAN_OPTIONS="suppressions=$root/.ci/tsan.supp:halt_on_error=1:second_deadlock_stack=1"
 (cd build-tsan && "${norandom[@]}" ./test_pipeline --gtest_brief=1)
 (cd build-tsan && "${norandom[@]}" ./test_slam --gtest_brief=1 \
   --gtest_filter='*SystemError*:EndToEnd.RealTimeModeTracksTheSameSequence')
 (cd build-tsan && "${norandom[@]}" ./test_semantic --gtest_brief=1 --gtest_filter='AsyncDetector.*')
 (cd build-tsan && "${norandom[@]}" ./test_viewer --gtest_brief=1)
-(cd build-tsan && "${norandom[@]}" ./test_api --gtest_brief=1 --gtest_filter='ApiSlam.AConsumerThread*:ApiSlam.AMapSaved*')
+(cd build-tsan && "${norandom[@]}" ./test_api --gtest_brief=1 \
+  --gtest_filter='ApiSlam.AConsumerThread*:ApiSlam.AMapSaved*:ApiSlam.TheDenseMap*')
+(cd build-tsan && "${norandom[@]}" ./test_dense --gtest_brief=1 --gtest_filter='DenseMapper.*')
 echo "[sanitize] no reports"

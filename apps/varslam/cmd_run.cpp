@@ -46,7 +46,8 @@ void add_run_command(CLI::App& app) {
   struct Opts {
     std::string dataset, settings, out = "out/run", groundtruth, save_map, load_map;
     bag::BagTopics topics;
-    bool realtime = false, pace = false, drop_late = false, quiet = false, localization_only = false;
+    bool realtime = false, pace = false, drop_late = false, quiet = false, localization_only = false,
+         dense_map = false;
     bool viewer = false, viewer_hold = false, viewer_wait = false;
     std::string viewer_address = "127.0.0.1";
     int viewer_port = 0;
@@ -84,6 +85,9 @@ void add_run_command(CLI::App& app) {
       ->check(finite_range(0.0, 1.0));
   cmd->add_option("--save-map", o->save_map, "Write the final map here (docs/map_format.md)")
       ->check(kNonEmptyPath);
+  cmd->add_flag("--dense-map", o->dense_map,
+                "Fuse a dense map of the static scene, movers left out: <out>/dense_mesh.ply and dense_map.bt "
+                "(settings section dense)");
   cmd->add_option("--load-map", o->load_map, "Start from this saved map: the first frames relocalize in it")
       ->check(kNonEmptyPath);
   cmd->add_flag("--localization-only", o->localization_only,
@@ -117,6 +121,7 @@ void add_run_command(CLI::App& app) {
                                    "not a .bag file",
                                    o->dataset));
     Settings settings = bag ? bag::settings_for_bag(o->dataset, sfile, t) : settings_for_dataset(o->dataset, sfile);
+    if (o->dense_map) o->overrides.insert(o->overrides.begin(), "dense.enabled=true");
     apply_setting_overrides(settings, o->overrides);
     auto dataset = bag ? bag::open_bag_dataset(o->dataset, settings, t) : open_dataset(o->dataset, settings);
     check_first_frame(o->first, dataset->size());

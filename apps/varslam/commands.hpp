@@ -22,5 +22,6 @@ void add_report_command(CLI::App& app);
 void add_settings_command(CLI::App& app);
 void add_view_command(CLI::App& app);
 void add_bag_command(CLI::App& app);
+void add_dense_bench_command(CLI::App& app);
 
 }  // namespace varslam::cli

@@ -99,6 +99,11 @@ class Slam {
   /// The latest consistent copy of the map, refreshed after every keyframe and whenever a caller asked since the
   /// last frame (so it is at most one frame old).
   std::shared_ptr<const MapSnapshot> map_snapshot() const;
+  /// The dense map of the static scene; empty (no keyframes) unless the settings say `dense.enabled: true`. From any
+  /// thread. Real-time mode: the map the dense-map thread holds now (each keyframe fused at the pose it had then, and
+  /// again when Local BA or a loop moved it). Deterministic mode: fused from the keyframes' current poses on the call
+  /// (it takes as long as fusing every keyframe). After finish(): fused from the final poses.
+  std::shared_ptr<const DenseMapSnapshot> dense_map_snapshot() const;
   /// Each frame's pose as tracking gave it (a copy).
   std::vector<TimedPose> live_trajectory() const;
   /// Every tracked frame's pose after every correction so far (Local BA, loops). Tracking thread, or after finish().

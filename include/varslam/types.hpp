@@ -12,6 +12,7 @@
 //   metres, 0 = no depth, both of the camera's size. Pixel coordinates: (0, 0) is the centre of the top-left pixel.
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -72,6 +73,18 @@ struct MapSnapshot {
   std::size_t frame_index = 0;  // frames tracked when it was taken
   std::vector<KeyframeInfo> keyframes;
   std::vector<MapPointInfo> points;
+};
+
+/// The dense map of the static scene (settings `dense.enabled`): what the keyframes' depth shows of the scene, the
+/// movers left out. A copy: it does not change after it is handed out.
+struct DenseMapSnapshot {
+  double voxel_size = 0;        // metres
+  std::size_t keyframes = 0;    // keyframes fused into it
+  std::vector<std::array<float, 3>> vertices;          // mesh, world frame, metres
+  std::vector<std::array<std::uint8_t, 3>> colours;    // RGB per vertex
+  std::vector<std::array<std::int32_t, 3>> triangles;  // vertex indices
+  std::vector<std::array<float, 3>> occupied;          // centres of the occupied voxels (the occupancy map)
+  std::vector<std::array<float, 3>> free;              // centres of the voxels seen free
 };
 
 /// One Local Bundle Adjustment of local mapping, with the shape of Barron's loss it chose.

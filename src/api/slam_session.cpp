@@ -12,6 +12,7 @@
 #include <varslam/slam.hpp>
 
 #include "api/config_access.hpp"
+#include "dense/dense_mapper.hpp"
 #include "mapfile/map_file.hpp"
 #include "pipeline/slam.hpp"
 #include "slam/keyframe.hpp"
@@ -319,6 +320,26 @@ std::shared_ptr<const MapSnapshot> Slam::map_snapshot() const {
   impl_->snapshot_wanted = true;
   std::lock_guard lock(impl_->views_mutex);
   return impl_->snapshot;
+}
+
+std::shared_ptr<const DenseMapSnapshot> Slam::dense_map_snapshot() const {
+  std::shared_ptr<dense::DenseMapper> d;
+  {
+    const auto lock = impl_->lock_from_other_thread();
+    d = impl_->pipeline->shared_dense_map();
+  }
+  auto out = std::make_shared<DenseMapSnapshot>();
+  if (!d) return out;
+  const dense::Mesh mesh = d->mesh();  // the dense map's own lock: tracking goes on meanwhile
+  const std::vector<dense::OccupancyVoxel> occ = d->occupancy();
+  out->voxel_size = d->config().tsdf.voxel_size;
+  out->keyframes = d->stats().keyframes;
+  out->vertices.reserve(mesh.vertices.size());
+  for (const auto& v : mesh.vertices) out->vertices.push_back({v.x(), v.y(), v.z()});
+  out->colours = mesh.colours;
+  out->triangles = mesh.triangles;
+  for (const auto& v : occ) (v.occupied ? out->occupied : out->free).push_back({v.centre.x(), v.centre.y(), v.centre.z()});
+  return out;
 }
 
 std::vector<TimedPose> Slam::live_trajectory() const {

@@ -216,12 +216,29 @@ inline constexpr KeySpec kKeys[] = {
     detail::flag("semantic.asynchronous", true, "real-time mode: detection on its own thread, tracking uses the freshest boxes (deterministic mode always waits)"),
     detail::flag("semantic.propagate_boxes", true, "shift stale boxes by optical flow"),
     detail::flag("semantic.mask_extraction", true, "extract no keypoints on the people, so their share of the budget goes to the background"),
+
+    // dense: the dense map of the static scene (a TSDF fused from the keyframes' depth, movers left out).
+    detail::flag("dense.enabled", false, "fuse the keyframes' depth into a dense map of the static scene (`varslam run --dense-map` sets it; outputs dense_mesh.ply and dense_map.bt)"),
+    detail::real("dense.voxel_size", 0.02, 0.005, 0.5, "voxel edge (m) of the dense map and of its occupancy map"),
+    detail::real("dense.truncation_voxels", 4.0, 1.0, 50.0, "truncation distance of the signed distance, in voxels"),
+    detail::real("dense.min_range", 0.2, 0.0, 100.0, "depth (m) below which a pixel is not fused"),
+    detail::positive("dense.max_range", 4.0, 100.0, "depth (m) beyond which a pixel is not fused (above dense.min_range)"),
+    detail::integer("dense.min_weight", 1, 1, 1000, "observations a voxel needs to be part of the mesh and the occupancy map"),
+    detail::integer("dense.pixel_step", 2, 1, 16, "fuse every n-th pixel of a keyframe in each direction (the keyframe store shrinks by its square)"),
+    detail::flag("dense.clear_free_space", true, "space a depth pixel sees through (beyond the truncation in front of its surface) is voted free, so a mover fused once and seen through later is removed"),
+    detail::integer("dense.keep_free_votes", 2, 0, 1000, "a voxel seen only as free space at least this many times stays free when a surface shows up in it (a mover no filter knew walked in); 0 = off"),
+    detail::flag("dense.exclude_movers", true, "leave out the pixels the system knows moved: people at their depth band, the near mover followed, keypoints flagged moving, the caller's mover mask (false: fuse every pixel)"),
+    detail::real("dense.moving_point_radius_px", 12.0, 0.0, 200.0, "radius (pixels) of the disc left out around a keypoint flagged moving (at its depth)"),
+    detail::integer("dense.mover_margin_px", 3, 0, 100, "the mover mask grows by this many pixels (the mixed depths at a mover's outline)"),
+    detail::positive("dense.reintegrate_m", 0.01, 10.0, "real-time mode: a keyframe whose pose moved this far (m) since it was fused is fused again"),
+    detail::positive("dense.reintegrate_deg", 0.5, 180.0, "... or turned this much (degrees)"),
 };
 // clang-format on
 
 /// Sections of the registry (the part of a key before the dot), in table order.
 inline constexpr std::string_view kSections[] = {"camera",   "depth", "orb",            "features", "tracking",
-                                                 "mapping",  "loop",  "relocalization", "semantic"};
+                                                 "mapping",  "loop",  "relocalization", "semantic",
+                                                 "dense"};
 
 /// ORB-SLAM3 / ORB-SLAM2 keys that varslam reads nothing from: accepted in settings files, never an error.
 /// An entry ending in '.' covers every key with that prefix.

@@ -12,6 +12,7 @@
 #include "io/colour_registration.hpp"
 #include "io/depth_image.hpp"
 #include "io/settings_registry.hpp"
+#include "dense/dense_mapper.hpp"
 #include "semantic/dynamic_keypoint_masker.hpp"
 #include "mapfile/map_file.hpp"
 
@@ -145,6 +146,7 @@ Pipeline::Pipeline(const Settings& settings, PipelineOptions options)
       options_(std::move(options)),
       semantic_(semantic::semantic_settings(settings)),
       relay_(std::make_unique<Relay>()) {
+  dense_cfg_ = std::make_unique<dense::DenseConfig>(dense::dense_config(settings_));
   // Deterministic mode waits for each frame's detections, so results do not depend on timing.
   if (options_.mode == RunMode::Deterministic) semantic_.asynchronous = false;
   if (options_.detector) {
@@ -195,6 +197,8 @@ void Pipeline::start(std::span<const RgbdFrame> samples) {
     pending_map_.reset();
   }
   system_->set_localization_only(localization_only_);
+  if (dense_cfg_->enabled)
+    dense_ = std::make_shared<dense::DenseMapper>(*dense_cfg_, settings_.camera, options_.mode == RunMode::RealTime);
   if (pending_pose_hint_) system_->set_pose_hint(pending_pose_hint_->first, pending_pose_hint_->second);
   pending_pose_hint_.reset();
   if (masker_) install_person_filter();
@@ -302,6 +306,7 @@ FrameResult Pipeline::track(const RgbdFrame& input, const std::optional<Detectio
     ++tracked_;
   }
 
+  if (dense_ && out.new_keyframe) give_dense_keyframe(frame, out);
   if (detection_) {
     detection_->index = r.index;
     emit(*std::exchange(detection_, std::nullopt), &Observer::on_detection);
@@ -315,6 +320,44 @@ FrameResult Pipeline::track(const RgbdFrame& input, const std::optional<Detectio
   emit(r, &Observer::on_frame);
   deliver_queued();
   return r;
+}
+
+// What the keyframe shows that moved (dense/mover_mask.hpp), gathered from the person filter, the near-mover track,
+// the keypoints tracking flagged and the caller's mask; the mask itself is made on the dense map's thread.
+void Pipeline::give_dense_keyframe(const RgbdFrame& frame, const slam::TrackOutcome& out) {
+  dense::DenseKeyframe kf;
+  kf.id = out.keyframe_id;
+  kf.timestamp = frame.timestamp;
+  kf.depth = frame.depth;
+  kf.bgr = frame.bgr;
+  kf.pose = [k = out.new_keyframe] { return Eigen::Isometry3d(k->resolved_pose().inverse()); };
+  dense::MoverMaskInputs& m = kf.movers;
+  m.point_radius_px = dense_cfg_->point_radius_px;
+  m.margin_px = dense_cfg_->margin_px;
+  m.caller_mask = frame.mover_mask;
+  if (detection_) {
+    const semantic::PersonRegions& p = detection_->people;
+    for (std::size_t i = 0; i < p.rects.size(); ++i) {
+      const semantic::PersonDepth& d = p.persons[i];
+      m.people.push_back({p.rects[i], d.whole_m, detection_->depth_band_m});
+      if (d.own_part_m > 0) m.people.push_back({p.rects[i], d.own_part_m, detection_->depth_band_m});
+    }
+  }
+  if (out.mover) {
+    const Eigen::AlignedBox2f& r = out.mover->region;
+    if (!r.isEmpty())
+      m.near_movers.push_back({cv::Rect2f(r.min().x(), r.min().y(), r.sizes().x(), r.sizes().y()),
+                               out.mover->near_depth, out.mover->far_depth, out.mover->depth_margin});
+  }
+  if (out.features) {
+    const slam::FrameFeatures& F = *out.features;
+    for (std::size_t i = 0; i < F.size(); ++i) {
+      const bool on_mover = i < out.on_mover.size() && out.on_mover[i];
+      const bool outlier = i < out.keypoint_fate.size() && out.keypoint_fate[i] == slam::KeypointFate::Outlier;
+      if (on_mover || outlier) m.moving_points.push_back({F.keypoints[i].pt, F.has_depth(i) ? F.depth[i] : 0.0f});
+    }
+  }
+  dense_->add(std::move(kf));
 }
 
 void Pipeline::deliver_queued() {
@@ -335,6 +378,7 @@ void Pipeline::finish() {
     throw;
   }
   deliver_queued();
+  if (dense_) dense_->finish();  // from the final keyframe poses
   const std::vector<Observer*> observers = observers_;
   for (Observer* o : observers) o->on_finished();
 }

@@ -35,6 +35,10 @@ inline constexpr std::string_view kVersion = VARSLAM_VERSION_STRING;
 namespace semantic {
 class DynamicKeypointMasker;
 }
+namespace dense {
+class DenseMapper;
+struct DenseConfig;
+}
 
 struct PipelineOptions {
   RunMode mode = RunMode::Deterministic;
@@ -119,6 +123,10 @@ class Pipeline {
   Trajectory keyframe_trajectory() const;
   const slam::Map& map() const;
   PipelineSummary summary() const;
+  /// The dense map of the static scene (dense.enabled), null when off or before the first frame. Final after
+  /// finish(); its mesh()/occupancy()/stats() may be read from any thread.
+  dense::DenseMapper* dense_map() const { return dense_.get(); }
+  std::shared_ptr<dense::DenseMapper> shared_dense_map() const { return dense_; }
 
   const Settings& settings() const { return settings_; }  // camera = the colour camera after registration
   const slam::SlamConfig& config() const { return cfg_; }
@@ -142,6 +150,9 @@ class Pipeline {
   std::unique_ptr<semantic::DynamicKeypointMasker> masker_;
   std::optional<DetectionEvent> detection_;  // of the frame being tracked, handed out after it
   std::unique_ptr<slam::System> system_;     // built by start(), once the colour camera is known
+  std::unique_ptr<dense::DenseConfig> dense_cfg_;
+  std::shared_ptr<dense::DenseMapper> dense_;  // dense.enabled: built by start() (it needs the colour camera)
+  void give_dense_keyframe(const RgbdFrame& frame, const slam::TrackOutcome& out);
   const slam::Map empty_map_;               // what map() shows before the first frame
   Trajectory live_;
   std::optional<mapfile::SavedMap> pending_map_;  // loaded, adopted when the system starts

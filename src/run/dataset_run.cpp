@@ -9,12 +9,14 @@
 #include <thread>
 
 #include "core/error.hpp"
+#include "dense/dense_mapper.hpp"
 #include "eval/ate.hpp"
 #include "eval/drag_events.hpp"
 #include "eval/rpe.hpp"
 #include "io/atomic_file.hpp"
 #include "io/file_problem.hpp"
 #include "io/output_folder.hpp"
+#include "io/settings_registry.hpp"
 #include "io/trajectory_io.hpp"
 #include "run/filter_stage_writer.hpp"
 #include "run/metrics_recorder.hpp"
@@ -125,7 +127,7 @@ std::string likely_cause(const MetricsRecorder& metrics, const Settings& setting
 }
 
 // Every file a run may write into its folder (the report is written beside it by the CLI).
-std::vector<OutputFile> run_outputs(const RunOptions& options) {
+std::vector<OutputFile> run_outputs(const RunOptions& options, bool dense) {
   std::vector<OutputFile> out = {{"CameraTrajectory.txt", "trajectory file"},
                                  {"CameraTrajectory_aligned.txt", "trajectory file"},
                                  {"KeyFrameTrajectory.txt", "trajectory file"},
@@ -135,6 +137,10 @@ std::vector<OutputFile> run_outputs(const RunOptions& options) {
                                  {"report.html", "report"}};
   for (const std::size_t f : options.debug_frames)
     out.push_back({FilterStageWriter::file_name(f), "filter stages image"});
+  if (dense) {
+    out.push_back({"dense_mesh.ply", "dense mesh"});
+    out.push_back({"dense_map.bt", "occupancy map"});
+  }
   return out;
 }
 
@@ -152,6 +158,38 @@ void check_debug_frames(const std::set<std::size_t>& frames, std::size_t first, 
 }
 
 }  // namespace
+
+nlohmann::json write_dense_map(dense::DenseMapper& d, const std::filesystem::path& out_dir) {
+  const auto t0 = Clock::now();
+  const dense::Mesh mesh = d.mesh();
+  const std::vector<dense::OccupancyVoxel> occ = d.occupancy();
+  const double extract_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  dense::write_mesh_ply(mesh, out_dir / "dense_mesh.ply");
+  dense::write_octomap_bt(occ, d.config().tsdf.voxel_size, out_dir / "dense_map.bt");
+  const dense::DenseStats st = d.stats();
+  auto pct = [&st](double q) {
+    if (st.integrate_ms.empty()) return 0.0;
+    std::vector<double> v = st.integrate_ms;
+    const auto k = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5);
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+    return v[k];
+  };
+  std::size_t occupied = 0;
+  for (const auto& v : occ) occupied += v.occupied ? 1 : 0;
+  return {{"keyframes", st.keyframes},
+          {"voxel_size", d.config().tsdf.voxel_size},
+          {"fusions", st.integrations},
+          {"reintegrations", st.reintegrations},
+          {"fuse_ms", {{"median", pct(0.5)}, {"p95", pct(0.95)}}},
+          {"final_rebuild_ms", st.final_rebuild_ms},
+          {"extract_ms", extract_ms},
+          {"blocks", st.blocks},
+          {"moving_pixel_share", st.moving_pixel_share},
+          {"mesh_vertices", mesh.vertices.size()},
+          {"mesh_triangles", mesh.triangles.size()},
+          {"occupied_voxels", occupied},
+          {"free_voxels", occ.size() - occupied}};
+}
 
 void write_map_ply(const slam::Map& map, const std::filesystem::path& file) {
   std::vector<Eigen::Vector3d> pts;
@@ -177,7 +215,8 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const RunO
     throw InputError(fmt::format("{}: ground truth file not found", options.groundtruth->string()));
   if (gt_path && std::filesystem::exists(*gt_path)) groundtruth = read_tum_trajectory(*gt_path);
 
-  const OutputFolder out(out_dir, run_outputs(options));
+  const bool dense = setting<bool>(settings, "dense.enabled");
+  const OutputFolder out(out_dir, run_outputs(options, dense));
   if (options.save_map) check_output_file(*options.save_map, "map");  // after the folder: the map may go into it
   Pipeline slam(settings, PipelineOptions{options.mode, nullptr});
   MetricsRecorder metrics;
@@ -260,6 +299,7 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const RunO
   write_map_ply(slam.map(), out_dir / "map.ply");
 
   nlohmann::json m = metrics.metrics(slam);
+  if (dense::DenseMapper* d = slam.dense_map()) m["dense_map"] = write_dense_map(*d, out_dir);
   m["final_poses_repaired"] = repaired;
   if (repaired > 0)
     spdlog::warn("{} final pose{} no frame supported (a lone keyframe left misplaced) replaced by the neighbours' "

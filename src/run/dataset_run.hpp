@@ -13,6 +13,10 @@
 #include "io/settings.hpp"
 #include "pipeline/slam.hpp"
 
+namespace varslam::dense {
+class DenseMapper;
+}
+
 namespace varslam::run {
 
 struct RunOptions {
@@ -58,6 +62,9 @@ struct RunSummary {
 /// is written atomically, and a second run into the same folder at the same time is refused (InputError).
 RunSummary run_slam(const Dataset& dataset, const Settings& settings, const RunOptions& options,
                     const std::filesystem::path& out_dir);
+
+/// Writes the dense map (dense_mesh.ply, dense_map.bt) into out_dir; returns its metrics.json entry.
+nlohmann::json write_dense_map(dense::DenseMapper& dense_map, const std::filesystem::path& out_dir);
 
 /// Writes the map's points as an ASCII PLY (x y z).
 void write_map_ply(const slam::Map& map, const std::filesystem::path& file);

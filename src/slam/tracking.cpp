@@ -112,7 +112,10 @@ TrackOutcome Tracker::track(const RgbdFrame& input) {
     record(cur, state_ == TrackState::Ok);
     out.state = state_;
     if (state_ == TrackState::Ok) out.live_T_wc = cur.T_cw.inverse();
-    if (out.keyframe && cur.reference_kf) out.keyframe_id = cur.reference_kf->id();
+    if (out.keyframe && cur.reference_kf) {
+      out.keyframe_id = cur.reference_kf->id();
+      out.new_keyframe = cur.reference_kf;
+    }
     out.timings.track_ms = ms_since(t_start);
     last_ = cur;
     return out;
@@ -174,7 +177,14 @@ TrackOutcome Tracker::track(const RgbdFrame& input) {
   }
   out.state = state_;
   if (state_ == TrackState::Ok) out.live_T_wc = cur.T_cw.inverse();
-  if (out.keyframe && cur.reference_kf) out.keyframe_id = cur.reference_kf->id();
+  if (out.keyframe && cur.reference_kf) {
+    out.keyframe_id = cur.reference_kf->id();
+    out.new_keyframe = cur.reference_kf;
+  }
+  out.on_mover = cur.on_mover;
+  if (mover_track_.active(cur.id))
+    out.mover = TrackOutcome::MoverRegion{mover_track_.region(), mover_track_.near_depth(), mover_track_.far_depth(),
+                                          mover_track_.config().depth_margin};
   const std::optional<Relocalization> relocalized = std::exchange(relocalized_, std::nullopt);
   if (state_ == TrackState::Ok && !out.new_segment) out.relocalized = relocalized;  // not when local-map tracking failed
   last_ = cur;

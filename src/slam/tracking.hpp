@@ -69,6 +69,16 @@ struct TrackOutcome {
   // it: an outlier is a match the kernel gave a weight below its gate (chi-square test of the weighted residual).
   std::shared_ptr<const FrameFeatures> features;
   std::vector<KeypointFate> keypoint_fate;
+  // The keyframe this frame became (keyframe == true), for consumers that follow its pose (the dense map).
+  std::shared_ptr<KeyFrame> new_keyframe;
+  // Per keypoint of `features`: on the near mover being followed (no point is built on it).
+  std::vector<bool> on_mover;
+  // The near mover followed at this frame (slam/mover_track.hpp): its image region and depth band.
+  struct MoverRegion {
+    Eigen::AlignedBox2f region;
+    float near_depth = 0, far_depth = 0, depth_margin = 0;
+  };
+  std::optional<MoverRegion> mover;
 };
 
 /// Pose of a frame kept relative to its reference keyframe, so later keyframe corrections (BA) move it too.

@@ -19,6 +19,7 @@
 #include "io/boxes_io.hpp"
 #include "io/settings.hpp"
 #include "synth/camera_path.hpp"
+#include "synth/world.hpp"
 #include "synth/movers.hpp"
 #include "synth/preview.hpp"
 #include "synth/renderer.hpp"
@@ -149,8 +150,7 @@ std::string pose_line(double ts, const Eigen::Isometry3d& T) {
 
 }  // namespace
 
-SynthSummary generate(const SynthConfig& cfg, const std::filesystem::path& out_dir) {
-  const auto wall_start = std::chrono::steady_clock::now();
+World build_world(const SynthConfig& cfg) {
   validate(cfg);
   std::string path_source;
   const Trajectory path = load_camera_path(cfg.path_file, &path_source);
@@ -163,16 +163,24 @@ SynthSummary generate(const SynthConfig& cfg, const std::filesystem::path& out_d
     throw InputError(fmt::format("{}: camera path is {:.2f} s long, but {:.2f} s starting at {:.2f} s were requested",
                                  path_source, path_len, cfg.seconds, cfg.path_start));
 
+  World w;
+  w.first_timestamp = t_first;
+  w.path_source = path_source;
+  w.path_length_s = path_len;
   // Path re-expressed relative to its first pose: the camera starts at the origin looking along +z.
   const Eigen::Isometry3d T0_inv = interpolate_pose(path, t_first).inverse();
-  const auto pose_at = [&](double t) { return Eigen::Isometry3d(T0_inv * interpolate_pose(path, t_first + t)); };
-  std::vector<Eigen::Isometry3d> poses(n_frames);
-  std::vector<double> stamps(n_frames);
+  w.pose_at = [T0_inv, path, t_first](double t) {
+    return Eigen::Isometry3d(T0_inv * interpolate_pose(path, t_first + t));
+  };
+  const auto& pose_at = w.pose_at;
+  std::vector<Eigen::Isometry3d>& poses = w.poses;
+  std::vector<double>& stamps = w.stamps;
+  poses.resize(n_frames);
+  stamps.resize(n_frames);
   for (std::size_t i = 0; i < n_frames; ++i) {
     stamps[i] = t_first + static_cast<double>(i) / cfg.fps;
     poses[i] = pose_at(static_cast<double>(i) / cfg.fps);
   }
-
   // Where the camera is and looks on average; the room, furniture and movers are laid out around that.
   ViewAnchor anchor;
   Eigen::Vector3d lo = poses[0].translation(), hi = lo, fwd_sum = Eigen::Vector3d::Zero();
@@ -192,7 +200,8 @@ SynthSummary generate(const SynthConfig& cfg, const std::filesystem::path& out_d
   // The room is laid out around the movers of every scenario, so it is the same for all of them (a function of
   // path and seed only) and scenarios differ only in the movers shown.
   const Movers all_movers = Movers::plan_all(anchor, floor_y, span, pose_at, mix_seed(seed, 11));
-  Movers movers = all_movers.select(cfg.scenario);
+  w.movers = all_movers.select(cfg.scenario);
+  Movers& movers = w.movers;
 
   Eigen::Vector3d room_lo = lo.array() - 1.5, room_hi = hi.array() + 1.5;
   auto enclose = [&](const Eigen::Vector3d& p, double margin) {
@@ -208,9 +217,27 @@ SynthSummary generate(const SynthConfig& cfg, const std::filesystem::path& out_d
 
   std::vector<KeepOut> keep = all_movers.keep_outs();
   for (std::size_t i = 0; i < n_frames; i += 5) keep.push_back({{poses[i].translation().x(), poses[i].translation().z()}, 0.6});
-  Scene scene = build_static_scene(room_lo, room_hi, anchor, keep, mix_seed(seed, 22));
-  movers.add_materials(scene);
+  w.scene = build_static_scene(room_lo, room_hi, anchor, keep, mix_seed(seed, 22));
+  movers.add_materials(w.scene);
+  w.room_lo = room_lo;
+  w.room_hi = room_hi;
+  return w;
+}
 
+
+SynthSummary generate(const SynthConfig& cfg, const std::filesystem::path& out_dir) {
+  const auto wall_start = std::chrono::steady_clock::now();
+  World w = build_world(cfg);
+  const Scene& scene = w.scene;
+  const Movers& movers = w.movers;
+  const std::vector<Eigen::Isometry3d>& poses = w.poses;
+  const std::vector<double>& stamps = w.stamps;
+  const auto& pose_at = w.pose_at;
+  const std::size_t n_frames = poses.size();
+  const std::uint64_t seed = cfg.seed;
+  const Eigen::Vector3d room_lo = w.room_lo, room_hi = w.room_hi;
+  const double t_first = w.first_timestamp, path_len = w.path_length_s;
+  const std::string& path_source = w.path_source;
   prepare_dir(out_dir);
   PinholeCamera cam;  // fx = fy = 525, cx = 319.5, cy = 239.5, 640x480, bf = 40
   const Renderer renderer(cam);

@@ -159,6 +159,42 @@ TEST(ApiSlam, AConsumerThreadReadsTheMapAndTrajectoryWhileTracking) {
   EXPECT_EQ(slam.map_snapshot()->keyframes.size(), slam.summary().keyframes);
 }
 
+// The dense map through the API: read from another thread while a real-time session tracks (ThreadSanitizer runs
+// this), final after finish(); empty when the settings do not ask for it.
+TEST(ApiSlam, TheDenseMapIsASnapshotAnyThreadMayRead) {
+  varslam::Config config = sequence().config;
+  config.set("dense.enabled", "true");
+  varslam::Slam slam(config, varslam::Mode::RealTime);
+  std::atomic<bool> done{false};
+  std::size_t reads = 0;
+  std::thread reader([&] {
+    while (!done) {
+      const auto d = slam.dense_map_snapshot();
+      for (const auto& t : d->triangles)
+        for (const auto i : t) ASSERT_LT(static_cast<std::size_t>(i), d->vertices.size());
+      ++reads;
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  });
+  for (const auto& f : sequence().frames) slam.track(f.bgr, f.depth, f.timestamp);
+  slam.finish();
+  done = true;
+  reader.join();
+  EXPECT_GT(reads, 2u);
+  const auto d = slam.dense_map_snapshot();
+  EXPECT_GE(d->keyframes, slam.summary().keyframes);  // culled keyframes stay in the dense map (at their parent's pose)
+  EXPECT_GT(d->keyframes, 2u);
+  EXPECT_DOUBLE_EQ(d->voxel_size, 0.02);
+  EXPECT_GT(d->vertices.size(), 5000u);
+  EXPECT_EQ(d->colours.size(), d->vertices.size());
+  EXPECT_GT(d->occupied.size(), 1000u);
+  EXPECT_GT(d->free.size(), d->occupied.size());
+
+  varslam::Slam without(sequence().config);
+  without.track(sequence().frames[0].bgr, sequence().frames[0].depth, sequence().frames[0].timestamp);
+  EXPECT_TRUE(without.dense_map_snapshot()->vertices.empty());
+}
+
 TEST(ApiSlam, AMapSavedWhileRunningIsFoundAgainAndResetStartsOver) {
   const auto& fr = sequence().frames;
   const fs::path map = fs::temp_directory_path() / ("varslam_api_" + std::to_string(::getpid()) + ".map");

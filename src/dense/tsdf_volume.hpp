@@ -1,0 +1,105 @@
+#pragma once
+// A truncated signed distance field on a sparse voxel grid (blocks of 8^3 voxels in a hash map), our own: depth
+// images are fused projectively, pixels marked as movers are left out of the surface, and every depth pixel clears
+// the space in front of what it sees (a voxel more than the truncation distance in front of the measured surface
+// gets a "free" observation, so a mover fused once and then seen through is voted away). Every update is a plain
+// weighted sum with weight 1 per observation, so a keyframe's contribution can be taken out again exactly the way it
+// was put in (integrate with sign -1): a keyframe whose pose changed after Local BA or a loop is re-integrated.
+//
+// Voxel (i, j, k) has its centre at ((i, j, k) + 0.5) * voxel_size in the world frame (the grid of an OcTree of
+// the same resolution). Not thread-safe: one thread owns a volume.
+#include <Eigen/Geometry>
+#include <array>
+#include <cstdint>
+#include <opencv2/core.hpp>
+#include <unordered_map>
+#include <vector>
+
+#include "core/camera.hpp"
+
+namespace varslam::dense {
+
+struct TsdfConfig {
+  double voxel_size = 0.02;        // metres
+  double truncation_voxels = 4.0;  // the truncation distance in voxels
+  // Metres along the optical axis: depth outside adds no surface; depth beyond max_range still clears the space
+  // up to max_range.
+  double min_range = 0.2, max_range = 4.0;
+  int min_weight = 1;              // observations a voxel needs to count (mesh, occupancy)
+  bool carve = true;               // free-space observations in front of the measured surface
+  // A voxel seen only as free space at least this many times stays free when a surface appears in it (something
+  // moved in); 0 = off.
+  int keep_free_votes = 2;
+  double truncation() const { return truncation_voxels * voxel_size; }
+};
+
+/// One image to fuse: depth (CV_32FC1, metres, 0 = none), optional colour (CV_8UC3, same size) and mover mask
+/// (CV_8UC1, non-zero = a mover: the pixel still clears the space in front of it, but adds no surface), seen by
+/// `camera` (its size = the images') from camera-to-world pose T_wc.
+struct DepthView {
+  cv::Mat depth, bgr, movers;
+  PinholeCamera camera;
+  Eigen::Isometry3d T_wc = Eigen::Isometry3d::Identity();
+};
+
+struct Voxel {
+  float sdf_sum = 0;   // sum of the truncated signed distances / truncation, in [-1, 1] each
+  float weight = 0;    // observations (surface and free)
+  float colour_weight = 0;
+  std::array<float, 3> bgr_sum{0, 0, 0};
+  float sdf() const { return weight > 0 ? sdf_sum / weight : 1.0f; }
+};
+
+struct Mesh {
+  std::vector<Eigen::Vector3f> vertices;
+  std::vector<std::array<std::uint8_t, 3>> colours;  // RGB per vertex
+  std::vector<std::array<std::int32_t, 3>> triangles;
+};
+
+/// A voxel of the occupancy grid: its centre and whether it is occupied (else observed free).
+struct OccupancyVoxel {
+  Eigen::Vector3f centre;
+  bool occupied = false;
+};
+
+struct IntegrationStats {
+  std::size_t blocks_touched = 0, voxels_updated = 0, voxels_carved = 0, voxels_kept_free = 0, pixels_used = 0,
+              pixels_moving = 0;
+};
+
+class TsdfVolume {
+ public:
+  static constexpr int kBlock = 8;
+  explicit TsdfVolume(const TsdfConfig& cfg);
+
+  /// Fuses (sign +1) or takes out again (sign -1, the same view and pose) one view.
+  IntegrationStats integrate(const DepthView& view, int sign = 1);
+  void clear() { blocks_.clear(); }
+
+  /// Surface (dual contouring of the zero crossings, vertex at the mean of its cell's edge crossings), vertices and
+  /// triangles in a deterministic order (blocks sorted by coordinate).
+  Mesh extract_mesh() const;
+  /// Voxels that count (min_weight): occupied where the surface is (sdf <= 0 within two voxels of the zero
+  /// crossing), free where the distance is positive. Sorted by coordinate.
+  std::vector<OccupancyVoxel> occupancy() const;
+
+  std::size_t block_count() const { return blocks_.size(); }
+  std::size_t observed_voxels() const;
+  const TsdfConfig& config() const { return cfg_; }
+  /// The voxel holding world point p, or null where nothing was allocated.
+  const Voxel* voxel_at(const Eigen::Vector3d& p) const;
+
+ private:
+  using BlockKey = std::uint64_t;
+  struct Block {
+    std::array<Voxel, kBlock * kBlock * kBlock> v;
+  };
+  static BlockKey key(int bx, int by, int bz);
+  static Eigen::Vector3i unkey(BlockKey k);
+  const Voxel* voxel(const Eigen::Vector3i& ijk) const;
+
+  TsdfConfig cfg_;
+  std::unordered_map<BlockKey, Block> blocks_;
+};
+
+}  // namespace varslam::dense
