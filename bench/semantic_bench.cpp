@@ -50,8 +50,8 @@ void run_yolo(benchmark::State& state, const std::string& model) {
 }
 void BM_YoloFastestXl(benchmark::State& state) { run_yolo(state, "yolo-fastest-1.1-xl"); }
 void BM_YoloFastestBody(benchmark::State& state) { run_yolo(state, "yolo-fastest-1.1_body"); }
-BENCHMARK(BM_YoloFastestXl)->ArgsProduct({{320, 416}, {1, 2}})->Unit(benchmark::kMillisecond)->MinTime(2.0);
-BENCHMARK(BM_YoloFastestBody)->Args({320, 1})->Args({320, 2})->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK(BM_YoloFastestXl)->ArgsProduct({{224, 256, 320, 416}, {1, 2}})->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK(BM_YoloFastestBody)->ArgsProduct({{224, 256, 320}, {1, 2}})->Unit(benchmark::kMillisecond)->MinTime(2.0);
 
 void BM_Hog(benchmark::State& state) {
   DetectorConfig cfg;

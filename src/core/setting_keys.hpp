@@ -213,8 +213,10 @@ inline constexpr KeySpec kKeys[] = {
     detail::integer("semantic.sample_step", 2, 1, 64, "depth samples every n-th pixel inside a box"),
     detail::real("semantic.silhouette_margin_px", 0.0, 0.0, 1000.0, "drop background keypoints this close (pixels) to the person's pixels; 0 = off"),
     detail::real("semantic.min_exclusive_share", 1.0, 0.0, 1.0, "overlapping boxes also get a person depth from their own part when it holds this share; 1 = off"),
-    detail::flag("semantic.asynchronous", true, "real-time mode: detection on its own thread, tracking uses the freshest boxes (deterministic mode always waits)"),
+    detail::flag("semantic.asynchronous", true, "real-time mode: detection on its own thread, tracking uses the freshest boxes (deterministic mode follows semantic.deterministic_detect_every and _lag)"),
     detail::flag("semantic.propagate_boxes", true, "shift stale boxes by optical flow"),
+    detail::integer("semantic.deterministic_detect_every", 0, 0, 5, "deterministic mode: the detector runs on every n-th frame (on its own thread) and the frames between use its boxes carried over by optical flow; 0 = 1 for a boxes file (it costs nothing), 2 for a detector that computes"),
+    detail::integer("semantic.deterministic_detect_lag", -1, -1, 5, "deterministic mode: a frame's detections are taken this many frames later (the detector runs meanwhile, beside tracking); 0 = on the frame itself; -1 = the frames between detections minus one; at most semantic.deterministic_detect_every"),
     detail::flag("semantic.mask_extraction", true, "extract no keypoints on the people, so their share of the budget goes to the background"),
 
     // dense: the dense map of the static scene (a TSDF fused from the keyframes' depth, movers left out).

@@ -63,6 +63,16 @@ void MetricsRecorder::on_detection(const DetectionEvent& d) {
   dropped_.push_back(d.stats.dropped);
 }
 
+// Frames whose boxes come from an image at most two frames older at 30 Hz (timestamps jitter by a few ms), out
+// of all frames the person filter saw, counting those before the first detection as not fresh.
+double MetricsRecorder::fresh_box_share() const {
+  constexpr double kFreshMs = 70.0;
+  const std::size_t frames = box_age_ms_.size() + static_cast<std::size_t>(frames_without_boxes_);
+  if (frames == 0) return 0.0;
+  const auto fresh = std::count_if(box_age_ms_.begin(), box_age_ms_.end(), [](double ms) { return ms <= kFreshMs; });
+  return static_cast<double>(fresh) / static_cast<double>(frames);
+}
+
 void MetricsRecorder::on_keyframe_mapped(const slam::KeyframeMapped& m) {
   keyframe_ms_.push_back(m.ms);
   ++keyframes_mapped_;
@@ -131,7 +141,8 @@ nlohmann::json MetricsRecorder::metrics(const Pipeline& slam) const {
   if (s.detector != "none" || semantic_ran_) {
     m["semantic"] = {{"detector", s.detector}, {"detector_runs", s.detector_runs},
                      {"asynchronous", s.detector_asynchronous}, {"frames_without_boxes", frames_without_boxes_},
-                     {"box_age", timing_json(box_age_ms_)}, {"detector_latency", timing_json(detector_latency_ms_)},
+                     {"box_age", timing_json(box_age_ms_)}, {"fresh_box_share", fresh_box_share()},
+                     {"detector_latency", timing_json(detector_latency_ms_)},
                      {"dropped_keypoints_per_frame", count_json(dropped_)}};
   }
   return m;

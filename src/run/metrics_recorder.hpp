@@ -49,6 +49,7 @@ class MetricsRecorder final : public Observer {
   std::vector<slam::LoopRecord> loops_;
   bool semantic_ran_ = false;
   long frames_without_boxes_ = 0;
+  double fresh_box_share() const;
   std::vector<double> box_age_ms_, detector_latency_ms_, dropped_;
   std::vector<double> latency_ms_, mapping_queue_;
   long dropped_frames_ = 0, late_frames_ = 0, ba_skipped_ = 0, ba_cut_short_ = 0, keyframes_mapped_ = 0;

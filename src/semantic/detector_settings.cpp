@@ -50,6 +50,15 @@ float real(const Settings& s, const char* key) { return static_cast<float>(setti
 
 }  // namespace
 
+int resolved_detect_every(const SemanticSettings& s) {
+  if (s.deterministic_detect_every > 0) return s.deterministic_detect_every;
+  return s.detector.source == "boxes" ? 1 : 2;
+}
+
+int resolved_detect_lag(const SemanticSettings& s) {
+  return s.deterministic_detect_lag >= 0 ? s.deterministic_detect_lag : resolved_detect_every(s) - 1;
+}
+
 SemanticSettings semantic_settings(const Settings& s) {
   SemanticSettings out;
   DetectorConfig& d = out.detector;
@@ -88,6 +97,13 @@ SemanticSettings semantic_settings(const Settings& s) {
   out.asynchronous = setting<bool>(s, "semantic.asynchronous");
   out.propagate_boxes = setting<bool>(s, "semantic.propagate_boxes");
   out.mask_extraction = setting<bool>(s, "semantic.mask_extraction");
+  out.deterministic_detect_every = setting<int>(s, "semantic.deterministic_detect_every");
+  out.deterministic_detect_lag = setting<int>(s, "semantic.deterministic_detect_lag");
+  if (resolved_detect_lag(out) > resolved_detect_every(out))
+    throw ConfigError(fmt::format("{}: key 'semantic.deterministic_detect_lag' ({}) must not exceed the frames between "
+                                  "detections (semantic.deterministic_detect_every, here {})",
+                                  s.source.empty() ? std::string("<settings>") : s.source.string(),
+                                  out.deterministic_detect_lag, resolved_detect_every(out)));
   return out;
 }
 

@@ -24,7 +24,10 @@ DynamicKeypointMasker::DynamicKeypointMasker(const SemanticSettings& settings)
     : DynamicKeypointMasker(make_detector(settings.detector), settings) {}
 
 DynamicKeypointMasker::DynamicKeypointMasker(std::unique_ptr<Detector> detector, const SemanticSettings& settings)
-    : settings_(settings), async_(std::move(detector)) {}
+    : settings_(settings),
+      every_(static_cast<std::size_t>(resolved_detect_every(settings))),
+      lag_(static_cast<std::size_t>(resolved_detect_lag(settings))),
+      async_(std::move(detector)) {}
 
 void DynamicKeypointMasker::boxes_for(const RgbdFrame& frame) {
   const std::pair<std::size_t, double> id{frame.index, frame.timestamp};
@@ -40,8 +43,8 @@ void DynamicKeypointMasker::boxes_for(const RgbdFrame& frame) {
     current_ = std::move(out);
     return;
   }
-  async_.submit(image, frame.timestamp);
-  if (!settings_.asynchronous) async_.wait_idle();
+  const std::optional<DetectionResult> latest = settings_.asynchronous ? submit_asynchronous(image, frame.timestamp)
+                                                                       : submit_on_schedule(image, frame.timestamp);
 
   const cv::Mat gray = gray_of(frame);
   if (settings_.propagate_boxes && !gray.empty()) {
@@ -50,7 +53,7 @@ void DynamicKeypointMasker::boxes_for(const RgbdFrame& frame) {
   }
 
   MaskResult out;
-  if (const auto latest = async_.latest()) {
+  if (latest) {
     out.have_detections = true;
     out.boxes = latest->detections;
     out.staleness_s = frame.timestamp - latest->timestamp;
@@ -67,6 +70,31 @@ void DynamicKeypointMasker::boxes_for(const RgbdFrame& frame) {
   }
   people_ = locate_people(image.size(), frame.depth, out.boxes, settings_.filter);
   current_ = std::move(out);
+}
+
+std::optional<DetectionResult> DynamicKeypointMasker::submit_asynchronous(const cv::Mat& image, double timestamp) {
+  async_.submit(image, timestamp);
+  return async_.latest();
+}
+
+// Which frames are detected and when their result is taken depend only on the frame count, never on timing: the
+// detector's run overlaps the tracking of the next frames and the output stays the same on any machine.
+std::optional<DetectionResult> DynamicKeypointMasker::submit_on_schedule(const cv::Mat& image, double timestamp) {
+  const auto take_when_due = [this] {
+    if (!outstanding_since_ || frames_seen_ - *outstanding_since_ < lag_)
+      return;
+    async_.wait_idle();
+    taken_ = async_.latest();
+    outstanding_since_.reset();
+  };
+  take_when_due();  // before submitting: a new frame must never replace one the schedule still waits for
+  if (frames_seen_ % every_ == 0) {
+    async_.submit(image, timestamp);
+    outstanding_since_ = frames_seen_;
+  }
+  take_when_due();  // lag 0: this frame's own detections
+  ++frames_seen_;
+  return taken_;
 }
 
 cv::Mat DynamicKeypointMasker::extraction_mask(const RgbdFrame& frame) {

@@ -54,14 +54,23 @@ class DynamicKeypointMasker {
   /// Submits the frame to the detector, takes the freshest boxes, moves them onto the frame and locates the people
   /// in its depth; once per frame (current_, people_).
   void boxes_for(const RgbdFrame& frame);
+  /// Real-time mode: every frame goes to the detector (replacing one it has not started); the freshest result.
+  std::optional<DetectionResult> submit_asynchronous(const cv::Mat& image, double timestamp);
+  /// Deterministic mode: every deterministic_detect_every-th frame goes to the detector; its result is taken
+  /// deterministic_detect_lag frames later (waiting for it then) and used until the next one is taken.
+  std::optional<DetectionResult> submit_on_schedule(const cv::Mat& image, double timestamp);
 
   SemanticSettings settings_;
+  std::size_t every_, lag_;  // the deterministic schedule, resolved
   MaskResult current_;    // boxes of the frame below (keep, stats unset)
   PersonRegions people_;  // the same boxes, enlarged, with their person depths
   std::optional<std::pair<std::size_t, double>> current_frame_;  // (index, timestamp)
   AsyncDetector async_;
   std::deque<PastGray> history_;  // recent gray images, to propagate boxes from the image they were found in
   std::optional<Detections> given_;  // the caller's boxes for the next frame
+  std::size_t frames_seen_ = 0;                   // frames given to the detector's schedule (deterministic)
+  std::optional<std::size_t> outstanding_since_;  // frame count of a submitted frame whose result is not taken
+  std::optional<DetectionResult> taken_;          // the result the schedule took last
 };
 
 }  // namespace varslam::semantic

@@ -31,6 +31,28 @@ TEST(DetectorSettings, ReadsAndChecksTheOverlapAndSilhouetteKeys) {
   EXPECT_THROW(semantic_settings(from_yaml("semantic:\n  min_exclusive_share: 1.5\n")), ConfigError);
 }
 
+// A boxes file costs nothing and is read on every frame; a detector that computes runs on every 2nd frame, its result
+// taken one frame later. Explicit values win; a lag beyond the frames between detections is refused by name.
+TEST(DetectorSettings, DeterministicScheduleResolvesByDetectorCost) {
+  const SemanticSettings boxes = semantic_settings(from_yaml("semantic:\n  detector: boxes\n"));
+  EXPECT_EQ(resolved_detect_every(boxes), 1);
+  EXPECT_EQ(resolved_detect_lag(boxes), 0);
+  const SemanticSettings hog = semantic_settings(from_yaml("semantic:\n  detector: hog\n"));
+  EXPECT_EQ(resolved_detect_every(hog), 2);
+  EXPECT_EQ(resolved_detect_lag(hog), 1);
+  const SemanticSettings given =
+      semantic_settings(from_yaml("semantic:\n  detector: hog\n  deterministic_detect_every: 3\n"
+                                  "  deterministic_detect_lag: 0\n"));
+  EXPECT_EQ(resolved_detect_every(given), 3);
+  EXPECT_EQ(resolved_detect_lag(given), 0);
+  try {
+    semantic_settings(from_yaml("semantic:\n  detector: boxes\n  deterministic_detect_lag: 2\n"));
+    FAIL() << "a lag of 2 with a detection on every frame was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("semantic.deterministic_detect_lag"), std::string::npos) << e.what();
+  }
+}
+
 TEST(DetectorSettings, ReadsTheSemanticSection) {
   const SemanticSettings ss = semantic_settings(from_yaml(R"(
 semantic:

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <map>
 #include <opencv2/imgproc.hpp>
 #include <optional>
 #include <thread>
@@ -70,10 +71,18 @@ struct Gate {
   ~Gate() { open = true; }
 };
 
-TEST(DynamicKeypointMasker, SynchronousModeUsesThisFramesBoxes) {
-  std::atomic<bool> open{true};
+// Deterministic mode with the detector waited for on every frame.
+SemanticSettings detect_every_frame() {
   SemanticSettings s;
   s.asynchronous = false;
+  s.deterministic_detect_every = 1;
+  s.deterministic_detect_lag = 0;
+  return s;
+}
+
+TEST(DynamicKeypointMasker, SynchronousModeUsesThisFramesBoxes) {
+  std::atomic<bool> open{true};
+  const SemanticSettings s = detect_every_frame();
   DynamicKeypointMasker masker(std::make_unique<ScriptedDetector>(&open), s);
   const RgbdFrame f = make_frame(2);
   const std::vector<cv::KeyPoint> kps = {{300, 200, 7}, {250, 300, 7}, {20, 20, 7}};  // person, wall, wall
@@ -87,8 +96,7 @@ TEST(DynamicKeypointMasker, SynchronousModeUsesThisFramesBoxes) {
 // Tracking asks for the extraction mask first, then filters: one detection per frame serves both.
 TEST(DynamicKeypointMasker, ExtractionMaskAndFilterShareTheFramesBoxes) {
   std::atomic<bool> open{true};
-  SemanticSettings s;
-  s.asynchronous = false;
+  const SemanticSettings s = detect_every_frame();
   DynamicKeypointMasker masker(std::make_unique<ScriptedDetector>(&open), s);
   const RgbdFrame f = make_frame(2);
   const cv::Mat mask = masker.extraction_mask(f);
@@ -126,6 +134,54 @@ TEST(DynamicKeypointMasker, StaleBoxesArePropagatedToTheCurrentFrame) {
       EXPECT_TRUE(r.keep[0]);
     }
   }
+}
+
+// Takes a fixed time per frame, so the schedule can be shown not to depend on how long detection takes.
+class SlowDetector final : public Detector {
+ public:
+  explicit SlowDetector(int ms) : ms_(ms) {}
+  Detections detect(const cv::Mat&, double t) override {
+    std::this_thread::sleep_for(std::chrono::milliseconds(ms_));
+    ++runs_on_[static_cast<int>(t)];
+    Detection d;
+    d.timestamp = t;
+    d.label = "person";
+    d.box = cv::Rect2f(static_cast<float>(person_x(t) - 10), 110, 110, 220);
+    return {d};
+  }
+  std::string name() const override { return "slow"; }
+  std::map<int, int> runs_on_;  // frame -> runs; read after the masker waited for the detector
+ private:
+  int ms_;
+};
+
+// Deterministic mode, detector on every 2nd frame, result taken one frame later: which frames are detected and which
+// boxes each frame gets follow from the frame count alone, however long the detector takes.
+TEST(DynamicKeypointMasker, DeterministicScheduleDependsOnTheFrameCountNotOnTiming) {
+  SemanticSettings s;
+  s.asynchronous = false;
+  s.deterministic_detect_every = 2;
+  s.deterministic_detect_lag = 1;
+  std::vector<std::vector<double>> staleness_per_run;
+  for (const int ms : {0, 40}) {
+    auto det = std::make_unique<SlowDetector>(ms);
+    SlowDetector* raw = det.get();
+    DynamicKeypointMasker masker(std::move(det), s);
+    std::vector<double> staleness;
+    for (int t = 0; t < 6; ++t) {
+      const MaskResult r = masker.process(make_frame(t), {{static_cast<float>(person_x(t) + 40), 200, 7}});
+      staleness.push_back(r.have_detections ? r.staleness_s : -1.0);
+      if (r.have_detections) {
+        EXPECT_FALSE(r.keep[0]) << "frame " << t << ": the box carried over by optical flow covers the person";
+        EXPECT_EQ(r.propagated, r.staleness_s > 0.0);
+      }
+    }
+    masker.wait_for_detector();
+    EXPECT_EQ(raw->runs_on_, (std::map<int, int>{{0, 1}, {2, 1}, {4, 1}})) << ms << " ms per detection";
+    staleness_per_run.push_back(staleness);
+  }
+  EXPECT_EQ(staleness_per_run[0], (std::vector<double>{-1, 1, 2, 1, 2, 1}));
+  EXPECT_EQ(staleness_per_run[1], staleness_per_run[0]);
 }
 
 TEST(DynamicKeypointMasker, NothingIsDroppedBeforeTheFirstDetection) {
