@@ -191,7 +191,7 @@ inline constexpr KeySpec kKeys[] = {
 
     // semantic: the person detector and the depth-aware keypoint filter.
     detail::choice("semantic.detector", "auto", "auto|yolo|boxes|hog|none", "person detector: auto (yolo when its model is found, else none, said once), yolo (OpenCV dnn), boxes (a boxes file), hog, none (no person filter)"),
-    detail::textual(KeyType::Text, "semantic.model", "yolo-fastest-1.1-xl", "YOLO preset (yolo-fastest-1.1-xl, yolo-fastest-1.1_body), looked up in model_dir, $VARSLAM_MODELS, ./models, ../shared/models, <install>/share/varslam/models"),
+    detail::textual(KeyType::Text, "semantic.model", "yolo-fastest-1.1_body", "YOLO preset (yolo-fastest-1.1_body: one class, a person; yolo-fastest-1.1-xl: 80 COCO classes, 2-2.5x the cost), looked up in model_dir, $VARSLAM_MODELS, ./models, ../shared/models, <install>/share/varslam/models"),
     detail::textual(KeyType::Path, "semantic.model_dir", "", "folder searched first for the model files"),
     detail::textual(KeyType::Path, "semantic.model_cfg", "", "Darknet cfg (with model_weights; instead of a preset)"),
     detail::textual(KeyType::Path, "semantic.model_weights", "", "Darknet weights or an ONNX file (instead of a preset)"),

@@ -19,7 +19,7 @@ struct DetectorConfig {
   // `model` (<model>.cfg + <model>.weights). A relative path that does not exist as given is looked up in
   // model_dir and the default model directories (see model_search_dirs). Empty names_file: <weights stem>.names,
   // else the preset's names (body.names for the body model), else coco.names.
-  std::string model{setting_keys::text_default("semantic.model")};  // or "yolo-fastest-1.1_body"
+  std::string model{setting_keys::text_default("semantic.model")};  // or "yolo-fastest-1.1-xl"
   std::filesystem::path model_dir;
   std::filesystem::path model_cfg, model_weights, names_file;
   int input_size = setting_keys::int_default("semantic.input_size");

@@ -3,7 +3,7 @@
 //
 //   semantic:
 //     detector: yolo            # yolo | boxes | hog | none
-//     model: yolo-fastest-1.1-xl  # preset, or model_cfg/model_weights (Darknet) / model_weights: x.onnx
+//     model: yolo-fastest-1.1_body  # preset, or model_cfg/model_weights (Darknet) / model_weights: x.onnx
 //     model_dir: ../models      # relative paths are relative to the settings file
 //     names_file: coco.names
 //     input_size: 320

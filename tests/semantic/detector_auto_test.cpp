@@ -19,7 +19,7 @@ TEST(DetectorAuto, IsTheDefaultAndFallsBackToNoneWithoutTheModel) {
 
 TEST(DetectorAuto, PicksYoloWhenTheModelIsFound) {
   const std::filesystem::path models = std::filesystem::path(VARSLAM_SHARED_DIR) / "models";
-  if (!std::filesystem::exists(models / "yolo-fastest-1.1-xl.weights")) GTEST_SKIP() << "no model in " << models;
+  if (!std::filesystem::exists(models / "yolo-fastest-1.1_body.weights")) GTEST_SKIP() << "no model in " << models;
   Settings s = default_settings();
   apply_setting_overrides(s, {"semantic.model_dir=" + models.string()});
   EXPECT_EQ(semantic_settings(s).detector.source, "yolo");

@@ -85,6 +85,7 @@ TEST(YoloDetector, BodyModelLabelIsAliasedToPerson) {
 TEST(YoloDetector, ClassFilterKeepsOnlyConfiguredLabels) {
   if (!testdata::have_yolo() || !testdata::have_video()) GTEST_SKIP() << "needs the shared model and vtest.avi";
   DetectorConfig cfg = yolo_config();
+  cfg.model = "yolo-fastest-1.1-xl";  // the 80-class model (the default body model knows only a person)
   cfg.classes = {"person", "handbag", "car"};
   auto det = make_detector(cfg);
   const cv::Mat frame = testdata::vtest_frame(0);
@@ -141,10 +142,11 @@ TEST(Detector, DefaultModelSearchHonoursVarslamModelsEnv) {
   cfg.source = "yolo";
   try {
     resolve_yolo_files(cfg);
-    if (!fs::exists("models/yolo-fastest-1.1-xl.weights") && !fs::exists("../shared/models/yolo-fastest-1.1-xl.weights"))
+    if (!fs::exists("models/yolo-fastest-1.1_body.weights") &&
+        !fs::exists("../shared/models/yolo-fastest-1.1_body.weights"))
       ADD_FAILURE() << "expected InputError";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("yolo-fastest-1.1-xl.weights"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("yolo-fastest-1.1_body.weights"), std::string::npos) << e.what();
   }
   ::unsetenv("VARSLAM_MODELS");
 }

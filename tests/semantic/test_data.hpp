@@ -8,9 +8,11 @@ namespace varslam::semantic::testdata {
 
 inline std::filesystem::path models_dir() { return std::filesystem::path(VARSLAM_SHARED_DIR) / "models"; }
 inline std::filesystem::path vtest_video() { return "/usr/share/doc/opencv-doc/examples/data/vtest.avi"; }
-inline bool have_yolo() {
-  return std::filesystem::exists(models_dir() / "yolo-fastest-1.1-xl.cfg") &&
-         std::filesystem::exists(models_dir() / "yolo-fastest-1.1-xl.weights");
+inline bool have_yolo() {  // both presets: the default (body) and the 80-class XL
+  for (const char* preset : {"yolo-fastest-1.1_body", "yolo-fastest-1.1-xl"})
+    for (const char* ext : {".cfg", ".weights"})
+      if (!std::filesystem::exists(models_dir() / (std::string(preset) + ext))) return false;
+  return true;
 }
 inline bool have_video() { return std::filesystem::exists(vtest_video()); }
 
