@@ -68,6 +68,31 @@ void DenseLayer::loop() {
   }
 }
 
+DenseRegionView DenseLayer::region_view(dense::SurfaceTracker::RegionKey region) const {
+  DenseRegionView v;
+  const Eigen::Vector3i i = dense::SurfaceTracker::region_index(region);
+  v.key = fmt::format("{},{},{}", i.x(), i.y(), i.z());
+  v.size = tracker_.region_size();
+  v.origin = i.cast<double>() * v.size;
+  v.cell = tracker_.cell_size();
+  return v;
+}
+
+bool DenseLayer::stopping() const {
+  std::lock_guard lock(mutex_);
+  return stopping_;
+}
+
+void DenseLayer::clear() {
+  stop();
+  std::lock_guard update(update_mutex_);
+  for (const auto region : posted_) {
+    const DenseRegionView v = region_view(region);
+    board_.set_dense_region(v.key, sse_event("dense", dense_region_message(v).dump()));
+  }
+  posted_.clear();
+}
+
 void DenseLayer::update() {
   std::lock_guard update(update_mutex_);
   update_locked(std::chrono::milliseconds(0));
@@ -76,7 +101,7 @@ void DenseLayer::update() {
 void DenseLayer::update_locked(std::chrono::milliseconds preview_budget) {
   const auto t0 = Clock::now();
   // Deterministic mode: fuse what came since, one keyframe per hold of the map's lock, within the budget.
-  while (Clock::now() - t0 < preview_budget && map_->preview_step()) {
+  while (Clock::now() - t0 < preview_budget && !stopping() && map_->preview_step()) {
   }
   const double preview_ms = ms_since(t0);
   const auto t1 = Clock::now();
@@ -84,12 +109,7 @@ void DenseLayer::update_locked(std::chrono::milliseconds preview_budget) {
   const std::vector<dense::SurfaceTracker::RegionKey> changed = tracker_.update(*map_);
   std::size_t bytes = 0, sent = 0;
   for (const auto region : changed) {
-    DenseRegionView v;
-    const Eigen::Vector3i i = dense::SurfaceTracker::region_index(region);
-    v.key = fmt::format("{},{},{}", i.x(), i.y(), i.z());
-    v.size = tracker_.region_size();
-    v.origin = i.cast<double>() * v.size;
-    v.cell = tracker_.cell_size();
+    DenseRegionView v = region_view(region);
     v.points = tracker_.region_points(region);
     if (v.points.empty() && !posted_.count(region)) continue;  // never shown: nothing to take away
     if (v.points.empty()) posted_.erase(region);

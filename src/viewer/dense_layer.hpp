@@ -15,6 +15,7 @@
 
 #include "dense/surface_tracker.hpp"
 #include "viewer/viewer_board.hpp"
+#include "viewer/viewer_messages.hpp"
 
 namespace varslam::dense {
 class DenseMapper;
@@ -49,11 +50,17 @@ class DenseLayer {
   void update();
   /// Stops the thread (after the run, before the final update()). Idempotent.
   void stop();
+  /// Stops the thread and takes every region it posted off the board (empty messages): the session's map was
+  /// replaced (a reset).
+  void clear();
   DenseLayerStats stats() const;
   const dense::DenseMapper& map() const { return *map_; }
 
  private:
   void loop();
+  bool stopping() const;
+  /// A region's message fields without its points.
+  DenseRegionView region_view(dense::SurfaceTracker::RegionKey region) const;
   void update_locked(std::chrono::milliseconds preview_budget);
 
   std::shared_ptr<dense::DenseMapper> map_;

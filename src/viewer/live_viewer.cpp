@@ -151,8 +151,10 @@ void LiveViewer::on_frame(const FrameResult& r) {
   if (slam_ && slam_->dense_map()) {
     std::lock_guard lock(dense_mutex_);
     // Once, or again for a new map (the session was reset): a pointer compare otherwise.
-    if (!dense_ || &dense_->map() != slam_->dense_map())
+    if (!dense_ || &dense_->map() != slam_->dense_map()) {
+      if (dense_) dense_->clear();  // the old map's regions off the page
       dense_ = std::make_unique<DenseLayer>(slam_->shared_dense_map(), board_, options_.dense);
+    }
   }
   if (board_.clients() > 0 && seconds_since(last_map_gather_) >= 1.0 / options_.map_rate) gather_map();
 }
