@@ -1,6 +1,6 @@
 // varslam viewer: the live (or finished) run streamed by the binary as server-sent events on /events.
-// Map in three.js (SLAM world: x right, y down, z forward; shown with y up), the current image with its
-// keypoints coloured by fate, stage times, the Local BA alpha per keyframe and the run's events.
+// Map in three.js (SLAM world: x right, y down, z forward; shown with y up) with the dense map of the static scene as
+// a layer of coloured surface points (runs with --dense-map), the current image with its keypoints coloured by fate, stage times, the Local BA alpha per keyframe and the run's events.
 import * as THREE from 'three';
 import { OrbitControls } from '/three/OrbitControls.js';
 
@@ -8,7 +8,7 @@ import { OrbitControls } from '/three/OrbitControls.js';
 const status = {
   connected: false, greeted: false, live: true, frames: 0, lastIndex: -1, state: '', maps: 0, points: 0,
   keyframes: 0, marks: 0, drawnMarks: 0, alphas: 0, events: 0, done: false, framesBeforeDone: 0, connections: 0,
-  renders: 0, softwareWebGL: false,
+  renders: 0, softwareWebGL: false, denseMessages: 0, denseRegions: 0, densePoints: 0, denseVisible: false,
 };
 window.viewerStatus = status;
 
@@ -23,6 +23,7 @@ function bytes(b64) {
   return out;
 }
 const f32 = (b64) => new Float32Array(bytes(b64).buffer);
+const i16 = (b64) => new Int16Array(bytes(b64).buffer);
 const i32 = (b64) => new Int32Array(bytes(b64).buffer);
 
 // ---------------------------------------------------------------- 3-D scene
@@ -67,6 +68,57 @@ const liveLine = line(0xff9f1c);
 const finalLine = line(0x4ea1ff);
 const gtLine = line(0xb0b0b0, 0.8);
 const cameraLines = line(0x3ddc84);
+
+// ---------------------------------------------------------------- the dense map's layer
+// One THREE.Points per region of the map (the server resends a region when its surface changed; none: it is empty).
+const denseGroup = new THREE.Group();
+world.add(denseGroup);
+const denseRegions = new Map();
+const denseMaterial = new THREE.PointsMaterial({ size: 0.04, sizeAttenuation: true, vertexColors: true });
+// Vertex colours are linear in three.js: the image's sRGB bytes converted once.
+const SRGB_TO_LINEAR = Float32Array.from({ length: 256 }, (_, v) => {
+  const c = v / 255;
+  return c <= 0.04045 ? c / 12.92 : ((c + 0.055) / 1.055) ** 2.4;
+});
+
+function showDense(d) {
+  const old = denseRegions.get(d.key);
+  if (old) {
+    denseGroup.remove(old);
+    old.geometry.dispose();
+    denseRegions.delete(d.key);
+  }
+  if (d.count > 0) {
+    const q = i16(d.xyz), rgb = bytes(d.rgb);
+    const xyz = new Float32Array(d.count * 3), colours = new Float32Array(d.count * 3);
+    for (let i = 0; i < d.count * 3; ++i) {
+      xyz[i] = d.origin[i % 3] + q[i] * d.unit;
+      colours[i] = SRGB_TO_LINEAR[rgb[i]];
+    }
+    const g = new THREE.BufferGeometry();
+    g.setAttribute('position', new THREE.BufferAttribute(xyz, 3));
+    g.setAttribute('color', new THREE.BufferAttribute(colours, 3));
+    g.computeBoundingSphere();
+    const pts = new THREE.Points(g, denseMaterial);
+    pts.userData.count = d.count;
+    denseGroup.add(pts);
+    denseRegions.set(d.key, pts);
+  }
+  denseMaterial.size = d.cell * 1.5;  // overlapping a little: reads as a surface
+  document.getElementById('dense-toggle').hidden = false;
+  status.denseMessages += 1;
+  status.denseRegions = denseRegions.size;
+  status.densePoints = 0;
+  for (const p of denseRegions.values()) status.densePoints += p.userData.count;
+  requestRender();
+}
+
+function clearDense() {
+  for (const p of denseRegions.values()) p.geometry.dispose();
+  denseRegions.clear();
+  denseGroup.clear();
+  status.denseRegions = status.densePoints = 0;
+}
 
 function setSegments(obj, array) {
   obj.geometry.dispose();
@@ -215,6 +267,8 @@ function applyVisibility() {
   treeLines.visible = graph;
   keyframeLines.visible = document.getElementById('show-keyframes').checked;
   gtLine.visible = document.getElementById('show-gt').checked;
+  denseGroup.visible = document.getElementById('show-dense').checked;
+  status.denseVisible = denseGroup.visible;
   requestRender();
 }
 
@@ -397,6 +451,7 @@ function connect() {
     status.greeted = true;
     status.live = h.live;
     alphas = [];
+    clearDense();
     document.getElementById('events').innerHTML = '';
     document.getElementById('title').textContent = `${h.title || ''}  (varslam ${h.version}${h.live ? ', live' : ', finished run'})`;
     document.getElementById('state-line').textContent = h.live ? 'waiting for the first frame…' : 'finished run';
@@ -404,6 +459,7 @@ function connect() {
   });
   on('frame', showFrame);
   on('map', showMap);
+  on('dense', showDense);
   on('alpha', (a) => {
     alphas.push(a);
     status.alphas = alphas.length;
@@ -423,10 +479,11 @@ function connect() {
   });
 }
 
-for (const id of ['show-graph', 'show-keyframes', 'show-gt']) document.getElementById(id).addEventListener('change', applyVisibility);
+for (const id of ['show-graph', 'show-keyframes', 'show-gt', 'show-dense']) document.getElementById(id).addEventListener('change', applyVisibility);
 document.getElementById('colour-by').addEventListener('change', () => { colourPoints(); requestRender(); });
 document.getElementById('reset-view').addEventListener('click', fitView);
 resize();
+applyVisibility();
 connect();
 // For debugging from the browser console.
-window.viewerScene = { scene, camera, controls, finalLine, liveLine, gtLine, keyframeLines, points };
+window.viewerScene = { scene, camera, controls, finalLine, liveLine, gtLine, keyframeLines, points, denseGroup };

@@ -27,6 +27,7 @@ inline constexpr FlagNeed kFlagNeeds[] = {
     {"run", "--viewer-port", "--viewer", "sets the live viewer's port"},
     {"run", "--viewer-address", "--viewer", "sets the live viewer's address"},
     {"run", "--viewer-fps", "--viewer", "limits the frames sent to the live viewer"},
+    {"run", "--viewer-dense-rate", "--viewer", "limits the live viewer's dense map updates"},
     {"run", "--viewer-hold", "--viewer", "keeps the live viewer up after the run"},
     {"run", "--viewer-wait", "--viewer", "waits for a browser at the live viewer"},
     {"run", "--localization-only", "--load-map", "needs a map to localize in"},

@@ -23,6 +23,7 @@ std::unique_ptr<viewer::LiveViewer> start_viewer(const Opts& o, const Dataset& d
   vo.server.address = o.viewer_address;
   vo.server.port = o.viewer_port;
   vo.max_frame_rate = o.viewer_fps;
+  vo.dense.rate = o.viewer_dense_rate;
   vo.title = dataset.root().filename().string();
   const auto gt = ro.groundtruth ? ro.groundtruth : dataset.groundtruth();
   if (gt && std::filesystem::exists(*gt)) {
@@ -52,6 +53,7 @@ void add_run_command(CLI::App& app) {
     std::string viewer_address = "127.0.0.1";
     int viewer_port = 0;
     double viewer_fps = 15;
+    double viewer_dense_rate = 0.5;
     std::size_t first = 0, max_frames = SIZE_MAX;
     double min_tracked_share = 0.5;
     std::vector<std::string> overrides;
@@ -104,6 +106,11 @@ void add_run_command(CLI::App& app) {
                   "Frames per second sent to the browser at most (lower it when the browser shares a small machine)")
       ->capture_default_str()
       ->check(finite_range(0.5, 60.0));
+  cmd->add_option("--viewer-dense-rate", o->viewer_dense_rate,
+                  "With --dense-map: updates of the dense map's layer per second at most (each sends only the "
+                  "regions that changed)")
+      ->capture_default_str()
+      ->check(finite_range(0.05, 10.0));
   cmd->add_flag("--viewer-hold", o->viewer_hold, "Keep the viewer up after the run until Ctrl+C");
   cmd->add_flag("--viewer-wait", o->viewer_wait, "Start the run only once a browser is connected");
   cmd->add_option("--set", o->overrides, "Override a setting: section.key=value (repeatable)");
@@ -156,6 +163,14 @@ void add_run_command(CLI::App& app) {
                    v.frames_sent, v.frames_seen, v.maps_encoded,
                    v.observer_ms_total / static_cast<double>(std::max<std::uint64_t>(1, v.frames_seen)),
                    v.observer_ms_max);
+      if (v.dense)
+        spdlog::info("viewer: dense layer: {} points in {} regions; {} updates sent {:.1f} KB ({} region messages); "
+                     "an update took {:.1f} ms of CPU at most to read and encode ({:.1f} ms in all; {:.0f} ms wall at idle "
+                     "priority), the largest was {:.1f} KB",
+                     v.dense->points, v.dense->regions, v.dense->updates,
+                     static_cast<double>(v.dense->bytes_sent) / 1024.0, v.dense->regions_sent, v.dense->max_update_cpu_ms,
+                     v.dense->update_cpu_ms, v.dense->max_update_ms,
+                     static_cast<double>(v.dense->max_update_bytes) / 1024.0);
     }
     write_report_for_run(s.out_dir, o->dataset);
     print_run_summary(s);

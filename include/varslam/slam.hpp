@@ -104,6 +104,10 @@ class Slam {
   /// again when Local BA or a loop moved it). Deterministic mode: fused from the keyframes' current poses on the call
   /// (it takes as long as fusing every keyframe). After finish(): fused from the final poses.
   std::shared_ptr<const DenseMapSnapshot> dense_map_snapshot() const;
+  /// The parts of the dense map `request` asks for (ConfigError naming the field for a bad one). With only the
+  /// surface asked for, deterministic mode fuses just the keyframes new since the last call (and those whose pose
+  /// moved) instead of every keyframe, and what finish() writes does not change.
+  std::shared_ptr<const DenseMapSnapshot> dense_map_snapshot(const DenseMapRequest& request) const;
   /// Each frame's pose as tracking gave it (a copy).
   std::vector<TimedPose> live_trajectory() const;
   /// Every tracked frame's pose after every correction so far (Local BA, loops). Tracking thread, or after finish().

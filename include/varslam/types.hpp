@@ -85,6 +85,20 @@ struct DenseMapSnapshot {
   std::vector<std::array<std::int32_t, 3>> triangles;  // vertex indices
   std::vector<std::array<float, 3>> occupied;          // centres of the occupied voxels (the occupancy map)
   std::vector<std::array<float, 3>> free;              // centres of the voxels seen free
+  std::vector<std::array<float, 3>> surface;           // points on the surface, thinned (DenseMapRequest)
+  std::vector<std::array<std::uint8_t, 3>> surface_colours;  // RGB per surface point
+};
+
+/// What Slam::dense_map_snapshot(request) fills in; the rest of the snapshot stays empty. Each part is a pass over
+/// the map: ask only for what you use.
+struct DenseMapRequest {
+  bool mesh = true;       // vertices, colours, triangles
+  bool occupancy = true;  // occupied, free
+  // surface, surface_colours: the mesh's vertices thinned to one per cube of surface_cell_voxels^3 voxels (1, 2, 4 or
+  // 8). Read incrementally: each call reads only what changed since the previous one, a few blocks at a time, so a
+  // periodic publisher costs little and never holds the dense map for long.
+  bool surface = false;
+  int surface_cell_voxels = 2;
 };
 
 /// One Local Bundle Adjustment of local mapping, with the shape of Barron's loss it chose.

@@ -86,6 +86,8 @@ VarslamNode::VarslamNode(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh), pnh
   state_pub_ = pnh_.advertise<std_msgs::String>("state", 10);
   alpha_pub_ = pnh_.advertise<std_msgs::Float64>("local_ba_alpha", 10);
   people_pub_ = pnh_.advertise<visualization_msgs::MarkerArray>("person_boxes", 10);
+  const bool dense = config_.get("dense.enabled") == "true";
+  if (dense) dense_pub_ = pnh_.advertise<sensor_msgs::PointCloud2>("dense_map", 1, true);
   people_sub_ = nh_.subscribe("people", 100, &VarslamNode::on_people, this);
   initial_pose_sub_ = nh_.subscribe("initialpose", 1, &VarslamNode::on_initial_pose, this);
   save_srv_ = pnh_.advertiseService("save_map", &VarslamNode::save_map, this);
@@ -104,6 +106,7 @@ VarslamNode::VarslamNode(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh), pnh
     tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_, nh_);
   }
   tracker_ = std::thread([this] { tracking_loop(); });
+  if (dense) dense_thread_ = std::thread([this] { dense_loop(); });
   ROS_INFO("varslam %s: colour %s, depth %s, camera %s; %s mode", varslam::Slam::version().c_str(),
            rgb_sub_.getTopic().c_str(), depth_sub_.getTopic().c_str(),
            have_camera_ ? params_.settings_file.c_str() : nh_.resolveName("rgb/camera_info").c_str(),
@@ -111,6 +114,12 @@ VarslamNode::VarslamNode(ros::NodeHandle nh, ros::NodeHandle pnh) : nh_(nh), pnh
 }
 
 VarslamNode::~VarslamNode() {
+  {
+    std::lock_guard<std::mutex> lock(dense_mutex_);
+    dense_stop_ = true;
+  }
+  dense_cv_.notify_all();
+  if (dense_thread_.joinable()) dense_thread_.join();
   {
     std::lock_guard<std::mutex> lock(queue_mutex_);
     stop_ = true;
@@ -233,6 +242,7 @@ void VarslamNode::ensure_session(const sensor_msgs::Image& rgb) {
                                             params_.realtime ? varslam::Mode::RealTime : varslam::Mode::Deterministic);
   }
   slam_->add_listener(*this);
+  session_ = slam_.get();
   // Read once: the camera does not change within a session (it is drawn with on every frame's person boxes).
   intrinsics_ = {std::stod(config_.get("camera.fx")), std::stod(config_.get("camera.fy")),
                  std::stod(config_.get("camera.cx")), std::stod(config_.get("camera.cy"))};
@@ -376,6 +386,45 @@ void VarslamNode::publish_map(const ros::Time& stamp) {
   }
   markers.markers.push_back(m);
   keyframes_pub_.publish(markers);
+}
+
+void VarslamNode::dense_loop() {
+  const auto period = std::chrono::duration<double>(1.0 / params_.dense_map_rate);
+  std::unique_lock<std::mutex> lock(dense_mutex_);
+  for (;;) {
+    if (dense_cv_.wait_for(lock, period, [&] { return dense_stop_; })) return;
+    const varslam::Slam* slam = session_.load();
+    if (!slam || dense_pub_.getNumSubscribers() == 0) continue;
+    lock.unlock();
+    try {
+      publish_dense(*slam);
+    } catch (const varslam::InputError& e) {
+      ROS_WARN_THROTTLE(10.0, "dense map not published: %s", e.what());
+    }
+    lock.lock();
+  }
+}
+
+void VarslamNode::publish_dense(const varslam::Slam& slam) {
+  varslam::DenseMapRequest request;
+  request.mesh = request.occupancy = false;
+  request.surface = true;
+  request.surface_cell_voxels = params_.dense_map_cell;
+  // Reads only what changed since the last cloud, a few blocks at a time: tracking goes on meanwhile.
+  const std::shared_ptr<const varslam::DenseMapSnapshot> map = slam.dense_map_snapshot(request);
+  sensor_msgs::PointCloud2 cloud;
+  cloud.header.stamp = ros::Time::now();
+  cloud.header.frame_id = params_.map_frame;
+  sensor_msgs::PointCloud2Modifier mod(cloud);
+  mod.setPointCloud2FieldsByString(2, "xyz", "rgb");
+  mod.resize(map->surface.size());
+  sensor_msgs::PointCloud2Iterator<float> x(cloud, "x"), y(cloud, "y"), z(cloud, "z");
+  sensor_msgs::PointCloud2Iterator<std::uint8_t> r(cloud, "r"), g(cloud, "g"), b(cloud, "b");
+  for (std::size_t i = 0; i < map->surface.size(); ++i, ++x, ++y, ++z, ++r, ++g, ++b) {
+    *x = map->surface[i][0], *y = map->surface[i][1], *z = map->surface[i][2];
+    *r = map->surface_colours[i][0], *g = map->surface_colours[i][1], *b = map->surface_colours[i][2];
+  }
+  dense_pub_.publish(cloud);
 }
 
 void VarslamNode::publish_corrected_path(const ros::Time& stamp) {

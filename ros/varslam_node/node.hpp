@@ -1,6 +1,6 @@
 #pragma once
 // varslam as a ROS 1 node: a thin adapter over the public API (varslam::Slam). Synchronised colour + depth in,
-// odometry, TF, paths, map points, keyframes, tracking state and Local BA alpha out; services to save and load the
+// odometry, TF, paths, map points, keyframes, tracking state, Local BA alpha and the dense map's surface out; services to save and load the
 // map, switch localization-only and reset. No SLAM logic here.
 #include <geometry_msgs/PolygonStamped.h>
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
@@ -68,6 +68,10 @@ class VarslamNode : public varslam::Listener {
   std::optional<geometry_msgs::TransformStamped> map_transform(const nav_msgs::Odometry& odom) const;
   void publish_map(const ros::Time& stamp);
   void publish_corrected_path(const ros::Time& stamp);
+  /// With dense mapping: the dense map's surface on ~dense_map at ~dense_map_rate, from its own thread (the image
+  /// callbacks and tracking never wait for it).
+  void dense_loop();
+  void publish_dense(const varslam::Slam& slam);
   void write_stats() const;
 
   bool save_map(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res);
@@ -86,7 +90,7 @@ class VarslamNode : public varslam::Listener {
   std::unique_ptr<message_filters::Synchronizer<SyncPolicy>> sync_;
   ros::Subscriber info_sub_, colour_count_sub_, people_sub_, initial_pose_sub_;
   ros::Publisher odom_pub_, tf_pub_, path_pub_, corrected_path_pub_, points_pub_, keyframes_pub_, state_pub_,
-      alpha_pub_, people_pub_;
+      alpha_pub_, people_pub_, dense_pub_;
   ros::ServiceServer save_srv_, load_srv_, reset_srv_, loc_srv_;
   // With ~odom_frame: odom -> camera comes from /tf, and map -> odom is what the node publishes.
   std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
@@ -103,6 +107,13 @@ class VarslamNode : public varslam::Listener {
   std::unique_lock<std::mutex> lock_for_service();
   // A hint that came before the session started (under session_mutex_): given to it when it starts.
   std::optional<std::pair<varslam::Pose, double>> pending_hint_;
+
+  // The session once it exists, for the dense map's thread (slam_ is the tracking thread's).
+  std::atomic<varslam::Slam*> session_{nullptr};
+  std::mutex dense_mutex_;
+  std::condition_variable dense_cv_;
+  bool dense_stop_ = false;
+  std::thread dense_thread_;
 
   // Owned by the tracking thread (stats_ also read by write_stats after it stopped).
   nav_msgs::Path live_path_;

@@ -11,7 +11,7 @@ namespace {
 const std::set<std::string> kNodeParams = {"settings_file", "map_frame",           "camera_frame",      "odom_frame",
                                            "map_file",      "load_map_at_start",   "localization_only", "realtime",
                                            "depth_unit",    "map_every_keyframes", "stats_file",        "viewer",
-                                           "viewer_port",   "viewer_address"};
+                                           "viewer_port",   "viewer_address",      "dense_map_rate",    "dense_map_cell"};
 
 std::string as_text(XmlRpc::XmlRpcValue& v, const std::string& name) {
   std::ostringstream s;
@@ -70,6 +70,14 @@ NodeParams read_params(const ros::NodeHandle& pnh, varslam::Config& config) {
   pnh.param("viewer", p.viewer, p.viewer);
   pnh.param("viewer_port", p.viewer_port, p.viewer_port);
   pnh.param("viewer_address", p.viewer_address, p.viewer_address);
+  pnh.param("dense_map_rate", p.dense_map_rate, p.dense_map_rate);
+  pnh.param("dense_map_cell", p.dense_map_cell, p.dense_map_cell);
+  if (!(p.dense_map_rate > 0 && p.dense_map_rate <= 30))
+    throw varslam::ConfigError("parameter ~dense_map_rate: " + std::to_string(p.dense_map_rate) +
+                               " clouds per second is not in (0, 30]");
+  if (p.dense_map_cell != 1 && p.dense_map_cell != 2 && p.dense_map_cell != 4 && p.dense_map_cell != 8)
+    throw varslam::ConfigError("parameter ~dense_map_cell: " + std::to_string(p.dense_map_cell) +
+                               " voxels is not 1, 2, 4 or 8");
   if (p.viewer_port < 0 || p.viewer_port > 65535)
     throw varslam::ConfigError("parameter ~viewer_port: " + std::to_string(p.viewer_port) + " is not a port (0-65535)");
   if (!(p.depth_unit > 0 && p.depth_unit < 1))

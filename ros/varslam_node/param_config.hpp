@@ -23,6 +23,9 @@ struct NodeParams {
   bool viewer = false;             // ~viewer: serve the live viewer (its address is logged)
   int viewer_port = 0;             // ~viewer_port (0: a free one)
   std::string viewer_address = "127.0.0.1";  // ~viewer_address
+  // With ~dense/enabled (the dense map of the static scene): its surface on ~dense_map as a PointCloud2.
+  double dense_map_rate = 1.0;  // ~dense_map_rate: clouds per second at most, (0, 30]
+  int dense_map_cell = 2;       // ~dense_map_cell: one point per cube of this many voxels (1, 2, 4 or 8)
 };
 
 /// Reads the node's parameters and applies every other private parameter to `config` as a setting. Throws

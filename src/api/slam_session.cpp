@@ -13,6 +13,7 @@
 
 #include "api/config_access.hpp"
 #include "dense/dense_mapper.hpp"
+#include "dense/surface_tracker.hpp"
 #include "mapfile/map_file.hpp"
 #include "pipeline/slam.hpp"
 #include "slam/keyframe.hpp"
@@ -84,6 +85,11 @@ struct Slam::Impl final : Observer {
   std::vector<TimedPose> live;
   SessionSummary summary;
   mutable std::atomic<bool> snapshot_wanted{false};
+  // Follows the dense map's surface between dense_map_snapshot() calls (remade for a new map or cell size).
+  mutable std::mutex dense_surface_mutex;
+  mutable std::unique_ptr<dense::SurfaceTracker> dense_surface;
+  mutable const dense::DenseMapper* dense_surface_of = nullptr;
+  mutable int dense_surface_cell = 0;
 
   std::optional<double> last_timestamp;
   bool relocalized_now = false;
@@ -322,7 +328,12 @@ std::shared_ptr<const MapSnapshot> Slam::map_snapshot() const {
   return impl_->snapshot;
 }
 
-std::shared_ptr<const DenseMapSnapshot> Slam::dense_map_snapshot() const {
+std::shared_ptr<const DenseMapSnapshot> Slam::dense_map_snapshot() const { return dense_map_snapshot({}); }
+
+std::shared_ptr<const DenseMapSnapshot> Slam::dense_map_snapshot(const DenseMapRequest& request) const {
+  const int cell = request.surface_cell_voxels;
+  if (request.surface && cell != 1 && cell != 2 && cell != 4 && cell != 8)
+    throw ConfigError(fmt::format("DenseMapRequest::surface_cell_voxels: {} is not 1, 2, 4 or 8", cell));
   std::shared_ptr<dense::DenseMapper> d;
   {
     const auto lock = impl_->lock_from_other_thread();
@@ -330,15 +341,34 @@ std::shared_ptr<const DenseMapSnapshot> Slam::dense_map_snapshot() const {
   }
   auto out = std::make_shared<DenseMapSnapshot>();
   if (!d) return out;
-  const dense::Mesh mesh = d->mesh();  // the dense map's own lock: tracking goes on meanwhile
-  const std::vector<dense::OccupancyVoxel> occ = d->occupancy();
+  // The dense map's own lock from here: tracking goes on meanwhile.
   out->voxel_size = d->config().tsdf.voxel_size;
   out->keyframes = d->stats().keyframes;
-  out->vertices.reserve(mesh.vertices.size());
-  for (const auto& v : mesh.vertices) out->vertices.push_back({v.x(), v.y(), v.z()});
-  out->colours = mesh.colours;
-  out->triangles = mesh.triangles;
-  for (const auto& v : occ) (v.occupied ? out->occupied : out->free).push_back({v.centre.x(), v.centre.y(), v.centre.z()});
+  if (request.mesh) {
+    const dense::Mesh mesh = d->mesh();
+    out->vertices.reserve(mesh.vertices.size());
+    for (const auto& v : mesh.vertices) out->vertices.push_back({v.x(), v.y(), v.z()});
+    out->colours = mesh.colours;
+    out->triangles = mesh.triangles;
+  }
+  if (request.occupancy)
+    for (const auto& v : d->occupancy())
+      (v.occupied ? out->occupied : out->free).push_back({v.centre.x(), v.centre.y(), v.centre.z()});
+  if (request.surface) {
+    std::lock_guard lock(impl_->dense_surface_mutex);
+    if (!impl_->dense_surface || impl_->dense_surface_of != d.get() || impl_->dense_surface_cell != cell) {
+      impl_->dense_surface = std::make_unique<dense::SurfaceTracker>(cell, out->voxel_size);
+      impl_->dense_surface_of = d.get();
+      impl_->dense_surface_cell = cell;
+    }
+    while (d->preview_step()) {  // deterministic mode: the keyframes not fused yet (one per hold of the lock)
+    }
+    impl_->dense_surface->update(*d);
+    for (const dense::SurfacePoint& p : impl_->dense_surface->all_points()) {
+      out->surface.push_back({p.position.x(), p.position.y(), p.position.z()});
+      out->surface_colours.push_back(p.rgb);
+    }
+  }
   return out;
 }
 

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <optional>
 #include <octomap/OcTree.h>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
@@ -94,7 +95,7 @@ DenseMapper::DenseMapper(const DenseConfig& cfg, const PinholeCamera& camera, bo
 
 DenseMapper::~DenseMapper() {
   {
-    std::lock_guard lock(mutex_);
+    std::lock_guard lock(queue_mutex_);
     stop_ = true;
   }
   wake_.notify_all();
@@ -123,19 +124,26 @@ void DenseMapper::add(DenseKeyframe kf) {
   if (kf.depth.type() != CV_32FC1) throw std::invalid_argument("DenseMapper::add: depth must be CV_32FC1");
   if (threaded_) {
     {
-      std::lock_guard lock(mutex_);
+      std::lock_guard lock(queue_mutex_);
       if (finished_) throw std::logic_error("DenseMapper::add after finish()");
       pending_.push_back(std::move(kf));
-      ++stats_.keyframes;
+      ++keyframes_;
     }
     wake_.notify_one();
     return;
   }
   Stored s = prepare(std::move(kf));
-  std::lock_guard lock(mutex_);
+  std::lock_guard lock(queue_mutex_);
   if (finished_) throw std::logic_error("DenseMapper::add after finish()");
-  store_.push_back(std::move(s));
-  ++stats_.keyframes;
+  arrived_.push_back(std::move(s));
+  ++keyframes_;
+}
+
+void DenseMapper::take_arrived_locked() {
+  std::lock_guard lock(queue_mutex_);
+  if (arrived_.empty()) return;
+  for (Stored& s : arrived_) store_.push_back(std::move(s));
+  arrived_.clear();
   dirty_ = true;
 }
 
@@ -155,22 +163,40 @@ bool DenseMapper::moved(const Stored& s, const Eigen::Isometry3d& now) const {
   return dt > cfg_.reintegrate_m || da > cfg_.reintegrate_deg;
 }
 
-void DenseMapper::fuse_locked(Stored& s, double* ms) {
+void DenseMapper::fuse_locked(Stored& s, double* ms, bool preview) {
   const auto t0 = std::chrono::steady_clock::now();
   const Eigen::Isometry3d now = s.pose();
   if (s.fused) {
     volume_.integrate(view_of(s, s.fused_pose), -1);
-    ++stats_.reintegrations;
+    if (!preview) ++stats_.reintegrations;
   }
   const IntegrationStats st = volume_.integrate(view_of(s, now), +1);
   used_pixels_ += st.pixels_used;
   moving_pixels_ += st.pixels_moving;
   s.fused = true;
   s.fused_pose = now;
-  ++stats_.integrations;
   const double t = ms_since(t0);
-  stats_.integrate_ms.push_back(t);
+  if (preview) {
+    ++stats_.preview_fusions;
+  } else {
+    ++stats_.integrations;
+    stats_.integrate_ms.push_back(t);
+  }
   if (ms) *ms += t;
+}
+
+bool DenseMapper::fuse_one_locked(bool preview) {
+  if (next_to_fuse_ < store_.size()) {
+    fuse_locked(store_[next_to_fuse_++], nullptr, preview);
+    return true;
+  }
+  // Then the keyframes whose pose moved since they were fused (one at a time: new keyframes come first).
+  for (Stored& s : store_)
+    if (s.fused && moved(s, s.pose())) {
+      fuse_locked(s, nullptr, preview);
+      return true;
+    }
+  return false;
 }
 
 void DenseMapper::rebuild_locked() {
@@ -191,53 +217,47 @@ void DenseMapper::worker() {
   sched_param idle{};
   if (pthread_setschedparam(pthread_self(), SCHED_IDLE, &idle) != 0)
     setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), 10);
-  std::unique_lock lock(mutex_);
-  while (!stop_) {
-    if (!pending_.empty()) {
-      DenseKeyframe kf = std::move(pending_.front());
-      pending_.pop_front();
-      lock.unlock();
-      Stored s = prepare(std::move(kf));
-      lock.lock();
-      store_.push_back(std::move(s));
-    }
-    if (next_to_fuse_ < store_.size()) {
-      fuse_locked(store_[next_to_fuse_++], nullptr);
-    } else if (pending_.empty()) {
-      // Idle: follow the keyframes whose pose moved since they were fused (one at a time, new keyframes first).
-      bool any = false;
-      for (Stored& s : store_) {
-        if (stop_ || !pending_.empty()) break;
-        if (s.fused && moved(s, s.pose())) {
-          fuse_locked(s, nullptr);
-          any = true;
-          break;
-        }
+  for (;;) {
+    std::optional<DenseKeyframe> kf;
+    {
+      std::lock_guard lock(queue_mutex_);
+      if (stop_) return;
+      if (!pending_.empty()) {
+        kf = std::move(pending_.front());
+        pending_.pop_front();
       }
-      if (!any) wake_.wait_for(lock, std::chrono::milliseconds(200));
-      continue;
     }
-    // Give readers (mesh(), stats()) a chance between keyframes.
-    lock.unlock();
-    std::this_thread::yield();
-    lock.lock();
+    bool worked = false;
+    {
+      std::optional<Stored> s;
+      if (kf) s = prepare(std::move(*kf));  // no lock: the mover mask and the downsampling take a while
+      std::lock_guard lock(mutex_);
+      if (s) store_.push_back(std::move(*s));
+      worked = fuse_one_locked(false);
+    }
+    if (worked) continue;  // readers (mesh(), stats()) get the volume's lock between keyframes
+    std::unique_lock lock(queue_mutex_);
+    wake_.wait_for(lock, std::chrono::milliseconds(200), [&] { return stop_ || !pending_.empty(); });
   }
 }
 
 void DenseMapper::finish() {
   {
-    std::lock_guard lock(mutex_);
+    std::lock_guard lock(queue_mutex_);
     if (finished_) return;
     stop_ = true;
   }
   wake_.notify_all();
   if (thread_.joinable()) thread_.join();
   std::lock_guard lock(mutex_);
-  finished_ = true;
-  while (!pending_.empty()) {
-    store_.push_back(prepare(std::move(pending_.front())));
-    pending_.pop_front();
+  std::deque<DenseKeyframe> left;
+  {
+    std::lock_guard queue(queue_mutex_);
+    finished_ = true;
+    left.swap(pending_);
   }
+  take_arrived_locked();
+  for (DenseKeyframe& kf : left) store_.push_back(prepare(std::move(kf)));
   const auto t0 = std::chrono::steady_clock::now();
   rebuild_locked();
   stats_.final_rebuild_ms = ms_since(t0);
@@ -245,19 +265,54 @@ void DenseMapper::finish() {
 
 Mesh DenseMapper::mesh() {
   std::lock_guard lock(mutex_);
+  take_arrived_locked();
   if (!threaded_ && dirty_) rebuild_locked();
   return volume_.extract_mesh();
 }
 
 std::vector<OccupancyVoxel> DenseMapper::occupancy() {
   std::lock_guard lock(mutex_);
+  take_arrived_locked();
   if (!threaded_ && dirty_) rebuild_locked();
   return volume_.occupancy();
+}
+
+bool DenseMapper::preview_step() {
+  if (threaded_) return false;
+  std::lock_guard lock(mutex_);
+  {
+    std::lock_guard queue(queue_mutex_);
+    if (finished_) return false;
+  }
+  take_arrived_locked();
+  if (!fuse_one_locked(true)) return false;
+  dirty_ = true;  // mesh() and occupancy() still fuse everything afresh: the same input gives the same map
+  return true;
+}
+
+DenseMapper::Changes DenseMapper::changes_since(std::uint64_t stamp) const {
+  std::lock_guard lock(mutex_);
+  return {volume_.epoch(), volume_.stamp(), volume_.changed_since(stamp)};
+}
+
+bool DenseMapper::read_surface(const std::vector<TsdfVolume::BlockKey>& keys, std::uint64_t epoch,
+                               std::vector<std::vector<SurfacePoint>>& out) const {
+  std::lock_guard lock(mutex_);
+  if (volume_.epoch() != epoch) return false;
+  for (const TsdfVolume::BlockKey k : keys) {
+    out.emplace_back();
+    volume_.block_surface(k, out.back());
+  }
+  return true;
 }
 
 DenseStats DenseMapper::stats() const {
   std::lock_guard lock(mutex_);
   DenseStats s = stats_;
+  {
+    std::lock_guard queue(queue_mutex_);
+    s.keyframes = keyframes_;
+  }
   s.blocks = volume_.block_count();
   const std::size_t all = used_pixels_ + moving_pixels_;
   s.moving_pixel_share = all ? static_cast<double>(moving_pixels_) / static_cast<double>(all) : 0.0;

@@ -7,7 +7,8 @@
 //    out and fuses again every keyframe whose pose moved (Local BA, a loop) by more than dense.reintegrate_m or
 //    dense.reintegrate_deg since it was fused. finish() fuses everything again from the final poses, so the map
 //    written at the end agrees with the final trajectory in both modes.
-// Owns its keyframe store and volume; add() and finish() from one thread, mesh()/occupancy()/stats() from any.
+// Owns its keyframe store and volume; add() and finish() from one thread, the readers from any. add() takes only
+// the queue's lock, never the volume's: the tracking thread does not wait for a fusion or a reader.
 #include <Eigen/Geometry>
 #include <condition_variable>
 #include <deque>
@@ -54,6 +55,7 @@ struct DenseKeyframe {
 
 struct DenseStats {
   std::size_t keyframes = 0, integrations = 0, reintegrations = 0, rebuilds = 0;
+  std::size_t preview_fusions = 0;  // deterministic mode: fusions for a live view (preview_step()), not counted above
   std::vector<double> integrate_ms;  // per fused keyframe (incremental or final), in order
   double final_rebuild_ms = 0;
   std::size_t blocks = 0;
@@ -77,6 +79,22 @@ class DenseMapper {
   Mesh mesh();
   std::vector<OccupancyVoxel> occupancy();
   DenseStats stats() const;
+
+  // For a live view that follows the map as it grows (dense/surface_tracker.hpp); each call holds the volume's lock
+  // for one keyframe's fusion or a few blocks' reading at most.
+  /// Deterministic mode: fuses one keyframe not fused yet, else one whose pose moved, from its current pose; false
+  /// when there is nothing to do. What finish() writes does not change (it fuses every keyframe again). Real-time
+  /// mode: false (the worker does this).
+  bool preview_step();
+  struct Changes {
+    std::uint64_t epoch = 0, stamp = 0;  // the volume's (TsdfVolume::epoch(), stamp()) when read
+    std::vector<TsdfVolume::BlockKey> blocks;
+  };
+  Changes changes_since(std::uint64_t stamp) const;
+  /// Surface points of each block in `keys` (in order), read while the volume is still in `epoch`; false when it
+  /// is not (the map was fused again from scratch: start over).
+  bool read_surface(const std::vector<TsdfVolume::BlockKey>& keys, std::uint64_t epoch,
+                    std::vector<std::vector<SurfacePoint>>& out) const;
   const DenseConfig& config() const { return cfg_; }
   /// The volume, for evaluation: after finish() only.
   const TsdfVolume& volume() const { return volume_; }
@@ -92,23 +110,34 @@ class DenseMapper {
   };
   Stored prepare(DenseKeyframe kf) const;
   DepthView view_of(const Stored& s, const Eigen::Isometry3d& T_wc) const;
-  void fuse_locked(Stored& s, double* ms);
+  void fuse_locked(Stored& s, double* ms, bool preview = false);
+  /// Fuses the next keyframe not fused yet, else one whose pose moved; false when there was none.
+  bool fuse_one_locked(bool preview);
   void rebuild_locked();
+  /// Moves the keyframes add() queued into the store (deterministic mode: prepared already).
+  void take_arrived_locked();
   void worker();
   bool moved(const Stored& s, const Eigen::Isometry3d& now) const;
 
   DenseConfig cfg_;
   PinholeCamera camera_;  // scaled to the stored images
   bool threaded_;
-  mutable std::mutex mutex_;  // guards everything below
+
+  // Lock order: mutex_, then queue_mutex_.
+  mutable std::mutex queue_mutex_;  // what add() touches
   std::condition_variable wake_;
   std::deque<DenseKeyframe> pending_;  // real-time mode: taken, not yet prepared
+  std::deque<Stored> arrived_;         // deterministic mode: prepared, not yet in the store
+  std::size_t keyframes_ = 0;
+  bool stop_ = false, finished_ = false;
+
+  mutable std::mutex mutex_;  // the store and the volume
   std::deque<Stored> store_;
   std::size_t next_to_fuse_ = 0;
   TsdfVolume volume_;
   DenseStats stats_;
   std::size_t used_pixels_ = 0, moving_pixels_ = 0;
-  bool stop_ = false, finished_ = false, dirty_ = false;
+  bool dirty_ = false;
   std::thread thread_;
 };
 

@@ -64,6 +64,7 @@ IntegrationStats TsdfVolume::integrate(const DepthView& view, int sign) {
   if (have_colour && (view.bgr.type() != CV_8UC3 || view.bgr.size() != view.depth.size()))
     throw std::invalid_argument("TsdfVolume::integrate: colour must be CV_8UC3 of the depth's size");
   IntegrationStats st;
+  ++stamp_;
   const double vs = cfg_.voxel_size, trunc = cfg_.truncation(), block_m = vs * kB;
   const PinholeCamera& cam = view.camera;
   const float min_r = static_cast<float>(cfg_.min_range), max_r = static_cast<float>(cfg_.max_range);
@@ -166,94 +167,158 @@ IntegrationStats TsdfVolume::integrate(const DepthView& view, int sign) {
           if (vox.weight <= 0.0f) vox = Voxel{};  // taken out again (or more than was put in): unobserved
           touched = true;
         }
-    if (touched) ++st.blocks_touched;
+    if (touched) {
+      ++st.blocks_touched;
+      block.stamp = stamp_;
+    }
   }
   return st;
 }
 
-namespace {
+// Reads the voxels that count (min_weight) by global coordinate, remembering the last block (meshing walks block by
+// block).
+class TsdfVolume::Reader {
+ public:
+  explicit Reader(const TsdfVolume& vol) : vol_(vol), min_w_(static_cast<float>(vol.cfg_.min_weight)) {}
+  const Voxel* operator()(const Eigen::Vector3i& ijk) {
+    const int bx = floor_div(ijk.x(), kB), by = floor_div(ijk.y(), kB), bz = floor_div(ijk.z(), kB);
+    const BlockKey k = key(bx, by, bz);
+    if (k != cached_key_) {
+      const auto it = vol_.blocks_.find(k);
+      cached_key_ = k;
+      cached_ = it == vol_.blocks_.end() ? nullptr : &it->second;
+    }
+    if (!cached_) return nullptr;
+    const Voxel* v = &cached_->v[local_index(ijk.x() - bx * kB, ijk.y() - by * kB, ijk.z() - bz * kB)];
+    return v->weight >= min_w_ ? v : nullptr;
+  }
 
-// Reads voxels by global coordinate, remembering the last block (meshing walks block by block).
+ private:
+  const TsdfVolume& vol_;
+  float min_w_;
+  BlockKey cached_key_ = ~BlockKey{0};
+  const Block* cached_ = nullptr;
+};
 
-}  // namespace
+bool TsdfVolume::cell_surface(const std::array<const Voxel*, 8>& c, const Eigen::Vector3i& o,
+                              SurfacePoint& out) const {
+  static const int kEdges[12][2] = {{0, 1}, {2, 3}, {4, 5}, {6, 7}, {0, 2}, {1, 3},
+                                    {4, 6}, {5, 7}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
+  const float vs = static_cast<float>(cfg_.voxel_size);
+  const auto centre = [vs](const Eigen::Vector3i& ijk) {
+    return Eigen::Vector3f((static_cast<float>(ijk.x()) + 0.5f) * vs, (static_cast<float>(ijk.y()) + 0.5f) * vs,
+                           (static_cast<float>(ijk.z()) + 0.5f) * vs);
+  };
+  if (!c[0] || std::abs(c[0]->sdf()) >= 1.0f) return false;
+  bool inside = false, outside = false;
+  for (const Voxel* v : c) {
+    if (!v) return false;
+    (v->sdf() < 0 ? inside : outside) = true;
+  }
+  if (!inside || !outside) return false;
+  Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+  int n = 0;
+  for (const auto& e : kEdges) {
+    const float sa = c[static_cast<std::size_t>(e[0])]->sdf(), sb = c[static_cast<std::size_t>(e[1])]->sdf();
+    if ((sa < 0) == (sb < 0)) continue;
+    if (std::abs(sa - sb) > 1.0f) return false;  // +free against -surface: not a crossing of one surface
+    const float t = sa / (sa - sb);
+    const Eigen::Vector3f pa = centre(o + Eigen::Vector3i(e[0] & 1, (e[0] >> 1) & 1, (e[0] >> 2) & 1));
+    const Eigen::Vector3f pb = centre(o + Eigen::Vector3i(e[1] & 1, (e[1] >> 1) & 1, (e[1] >> 2) & 1));
+    sum += pa + t * (pb - pa);
+    ++n;
+  }
+  if (n == 0) return false;
+  // Colour: the corner nearest the surface that has colour.
+  const Voxel* best = nullptr;
+  for (const Voxel* cv : c)
+    if (cv->colour_weight > 0 && (!best || std::abs(cv->sdf()) < std::abs(best->sdf()))) best = cv;
+  out.rgb = {200, 200, 200};
+  if (best)
+    for (int ch = 0; ch < 3; ++ch)
+      out.rgb[static_cast<std::size_t>(2 - ch)] = static_cast<std::uint8_t>(
+          std::clamp(best->bgr_sum[static_cast<std::size_t>(ch)] / best->colour_weight, 0.0f, 255.0f));
+  out.position = sum / static_cast<float>(n);
+  return true;
+}
+
+std::vector<TsdfVolume::BlockKey> TsdfVolume::changed_since(std::uint64_t since) const {
+  std::vector<BlockKey> out;
+  for (const auto& [k, b] : blocks_) {
+    if (b.stamp <= since) continue;
+    const Eigen::Vector3i c = unkey(k);
+    for (int i = 0; i < 8; ++i) {
+      const BlockKey n = key(c.x() - (i & 1), c.y() - ((i >> 1) & 1), c.z() - ((i >> 2) & 1));
+      if (i == 0 || blocks_.count(n)) out.push_back(n);
+    }
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+void TsdfVolume::block_surface(BlockKey k, std::vector<SurfacePoint>& out) const {
+  const auto it = blocks_.find(k);
+  if (it == blocks_.end()) return;
+  // The block's voxels and the first layer of its +x, +y, +z neighbours (what its cells read), looked up once.
+  constexpr int N = kB + 1;
+  const Eigen::Vector3i b = unkey(k);
+  std::array<const Block*, 8> near{};
+  for (int i = 0; i < 8; ++i) {
+    const auto n = blocks_.find(key(b.x() + (i & 1), b.y() + ((i >> 1) & 1), b.z() + ((i >> 2) & 1)));
+    near[static_cast<std::size_t>(i)] = n == blocks_.end() ? nullptr : &n->second;
+  }
+  const auto min_w = static_cast<float>(cfg_.min_weight);
+  std::array<const Voxel*, N * N * N> v{};
+  for (int z = 0; z < N; ++z)
+    for (int y = 0; y < N; ++y)
+      for (int x = 0; x < N; ++x) {
+        const Block* blk = near[static_cast<std::size_t>((x / kB) | ((y / kB) << 1) | ((z / kB) << 2))];
+        if (!blk) continue;
+        const Voxel* vox = &blk->v[local_index(x % kB, y % kB, z % kB)];
+        if (vox->weight >= min_w) v[static_cast<std::size_t>((z * N + y) * N + x)] = vox;
+      }
+  SurfacePoint p;
+  std::array<const Voxel*, 8> c{};
+  for (int z = 0; z < kB; ++z)
+    for (int y = 0; y < kB; ++y)
+      for (int x = 0; x < kB; ++x) {
+        for (int i = 0; i < 8; ++i)
+          c[static_cast<std::size_t>(i)] =
+              v[static_cast<std::size_t>(((z + ((i >> 2) & 1)) * N + y + ((i >> 1) & 1)) * N + x + (i & 1))];
+        if (cell_surface(c, b * kB + Eigen::Vector3i(x, y, z), p)) out.push_back(p);
+      }
+}
 
 Mesh TsdfVolume::extract_mesh() const {
   Mesh mesh;
   const auto min_w = static_cast<float>(cfg_.min_weight);
-  const float vs = static_cast<float>(cfg_.voxel_size);
   std::vector<BlockKey> keys;
   keys.reserve(blocks_.size());
   for (const auto& [k, b] : blocks_) keys.push_back(k);
   std::sort(keys.begin(), keys.end());
-
-  // Global voxel lookup with a one-block cache.
-  BlockKey cached_key = ~BlockKey{0};
-  const Block* cached = nullptr;
-  auto at = [&](const Eigen::Vector3i& ijk) -> const Voxel* {
-    const int bx = floor_div(ijk.x(), kB), by = floor_div(ijk.y(), kB), bz = floor_div(ijk.z(), kB);
-    const BlockKey k = key(bx, by, bz);
-    if (k != cached_key) {
-      const auto it = blocks_.find(k);
-      cached_key = k;
-      cached = it == blocks_.end() ? nullptr : &it->second;
-    }
-    if (!cached) return nullptr;
-    const Voxel* v = &cached->v[local_index(ijk.x() - bx * kB, ijk.y() - by * kB, ijk.z() - bz * kB)];
-    return v->weight >= min_w ? v : nullptr;
-  };
+  Reader at(*this);
   auto cell_key = [](const Eigen::Vector3i& c) { return pack(c.x(), c.y(), c.z()); };
-  auto centre = [vs](const Eigen::Vector3i& ijk) {
-    return Eigen::Vector3f((static_cast<float>(ijk.x()) + 0.5f) * vs, (static_cast<float>(ijk.y()) + 0.5f) * vs,
-                           (static_cast<float>(ijk.z()) + 0.5f) * vs);
-  };
-  static const int kEdges[12][2] = {{0, 1}, {2, 3}, {4, 5}, {6, 7}, {0, 2}, {1, 3},
-                                    {4, 6}, {5, 7}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
 
   // 1. One vertex per cell (8 voxel centres) the surface passes through.
   std::unordered_map<std::uint64_t, std::int32_t> cell_vertex;
+  SurfacePoint p;
+  std::array<const Voxel*, 8> c{};
   for (const BlockKey k : keys) {
     const Eigen::Vector3i b = unkey(k) * kB;
     const Block& block = blocks_.at(k);
     for (int z = 0; z < kB; ++z)
       for (int y = 0; y < kB; ++y)
         for (int x = 0; x < kB; ++x) {
-          const Voxel& v0 = block.v[local_index(x, y, z)];
-          if (v0.weight < min_w || std::abs(v0.sdf()) >= 1.0f) continue;
           const Eigen::Vector3i o = b + Eigen::Vector3i(x, y, z);
-          std::array<const Voxel*, 8> c{};
-          bool complete = true, inside = false, outside = false;
-          for (int i = 0; i < 8 && complete; ++i) {
+          const Voxel& v0 = block.v[local_index(x, y, z)];
+          if (v0.weight < min_w || std::abs(v0.sdf()) >= 1.0f) continue;  // no surface: skip the corner lookups
+          for (int i = 0; i < 8; ++i)
             c[static_cast<std::size_t>(i)] = at(o + Eigen::Vector3i(i & 1, (i >> 1) & 1, (i >> 2) & 1));
-            if (!c[static_cast<std::size_t>(i)]) complete = false;
-            else (c[static_cast<std::size_t>(i)]->sdf() < 0 ? inside : outside) = true;
-          }
-          if (!complete || !inside || !outside) continue;
-          Eigen::Vector3f sum = Eigen::Vector3f::Zero();
-          int n = 0;
-          bool spurious = false;
-          for (const auto& e : kEdges) {
-            const float sa = c[static_cast<std::size_t>(e[0])]->sdf(), sb = c[static_cast<std::size_t>(e[1])]->sdf();
-            if ((sa < 0) == (sb < 0)) continue;
-            if (std::abs(sa - sb) > 1.0f) spurious = true;  // +free against -surface: not a crossing of one surface
-            const float t = sa / (sa - sb);
-            const Eigen::Vector3f pa = centre(o + Eigen::Vector3i(e[0] & 1, (e[0] >> 1) & 1, (e[0] >> 2) & 1));
-            const Eigen::Vector3f pb = centre(o + Eigen::Vector3i(e[1] & 1, (e[1] >> 1) & 1, (e[1] >> 2) & 1));
-            sum += pa + t * (pb - pa);
-            ++n;
-          }
-          if (spurious || n == 0) continue;
-          // Colour: the corner nearest the surface that has colour.
-          const Voxel* best = nullptr;
-          for (const Voxel* cv : c)
-            if (cv->colour_weight > 0 && (!best || std::abs(cv->sdf()) < std::abs(best->sdf()))) best = cv;
-          std::array<std::uint8_t, 3> rgb{200, 200, 200};
-          if (best)
-            for (int ch = 0; ch < 3; ++ch)
-              rgb[static_cast<std::size_t>(2 - ch)] = static_cast<std::uint8_t>(
-                  std::clamp(best->bgr_sum[static_cast<std::size_t>(ch)] / best->colour_weight, 0.0f, 255.0f));
+          if (!cell_surface(c, o, p)) continue;
           cell_vertex.emplace(cell_key(o), static_cast<std::int32_t>(mesh.vertices.size()));
-          mesh.vertices.push_back(sum / static_cast<float>(n));
-          mesh.colours.push_back(rgb);
+          mesh.vertices.push_back(p.position);
+          mesh.colours.push_back(p.rgb);
         }
   }
 

@@ -56,6 +56,12 @@ struct Mesh {
   std::vector<std::array<std::int32_t, 3>> triangles;
 };
 
+/// A point on the surface: the mesh vertex of one voxel cell the surface passes through, with its colour.
+struct SurfacePoint {
+  Eigen::Vector3f position;
+  std::array<std::uint8_t, 3> rgb{};
+};
+
 /// A voxel of the occupancy grid: its centre and whether it is occupied (else observed free).
 struct OccupancyVoxel {
   Eigen::Vector3f centre;
@@ -70,11 +76,28 @@ struct IntegrationStats {
 class TsdfVolume {
  public:
   static constexpr int kBlock = 8;
+  using BlockKey = std::uint64_t;
   explicit TsdfVolume(const TsdfConfig& cfg);
 
   /// Fuses (sign +1) or takes out again (sign -1, the same view and pose) one view.
   IntegrationStats integrate(const DepthView& view, int sign = 1);
-  void clear() { blocks_.clear(); }
+  void clear() {
+    blocks_.clear();
+    ++epoch_;
+  }
+
+  // Following the surface as it changes (a live view reads only what changed): every integrate() advances the
+  // stamp, and each block it changed keeps the stamp of that change. clear() starts a new epoch.
+  std::uint64_t stamp() const { return stamp_; }
+  std::uint64_t epoch() const { return epoch_; }
+  /// Blocks changed after `since`, and the blocks whose surface cells read a changed block (a cell reads the
+  /// voxels at +0/+1 on each axis, so a change reaches the blocks below it too).
+  std::vector<BlockKey> changed_since(std::uint64_t since) const;
+  /// The surface points (extract_mesh()'s vertices) of the cells whose first corner is in block k; none when k is
+  /// not allocated.
+  void block_surface(BlockKey k, std::vector<SurfacePoint>& out) const;
+  static Eigen::Vector3i block_coords(BlockKey k) { return unkey(k); }
+  static BlockKey block_key(const Eigen::Vector3i& b) { return key(b.x(), b.y(), b.z()); }
 
   /// Surface (dual contouring of the zero crossings, vertex at the mean of its cell's edge crossings), vertices and
   /// triangles in a deterministic order (blocks sorted by coordinate).
@@ -90,16 +113,21 @@ class TsdfVolume {
   const Voxel* voxel_at(const Eigen::Vector3d& p) const;
 
  private:
-  using BlockKey = std::uint64_t;
   struct Block {
     std::array<Voxel, kBlock * kBlock * kBlock> v;
+    std::uint64_t stamp = 0;  // of the last integrate() that changed it
   };
+  class Reader;
   static BlockKey key(int bx, int by, int bz);
   static Eigen::Vector3i unkey(BlockKey k);
   const Voxel* voxel(const Eigen::Vector3i& ijk) const;
+  /// The surface point of the voxel cell with first corner o, if the surface passes through it; c: its corners
+  /// (x fastest), null where a voxel does not count (min_weight).
+  bool cell_surface(const std::array<const Voxel*, 8>& c, const Eigen::Vector3i& o, SurfacePoint& out) const;
 
   TsdfConfig cfg_;
   std::unordered_map<BlockKey, Block> blocks_;
+  std::uint64_t stamp_ = 0, epoch_ = 0;
 };
 
 }  // namespace varslam::dense

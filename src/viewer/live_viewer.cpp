@@ -63,6 +63,10 @@ void LiveViewer::stop() {
   }
   wake_.notify_all();
   if (encoder_.joinable()) encoder_.join();
+  {
+    std::lock_guard lock(dense_mutex_);
+    dense_.reset();
+  }
   server_.stop();
 }
 
@@ -70,6 +74,8 @@ LiveViewerStats LiveViewer::stats() const {
   std::lock_guard lock(mutex_);
   LiveViewerStats s = stats_;
   s.frames_sent = board_.frames_sent();
+  std::lock_guard dense(dense_mutex_);
+  if (dense_) s.dense = dense_->stats();
   return s;
 }
 
@@ -142,6 +148,14 @@ void LiveViewer::on_frame(const FrameResult& r) {
   }
   building_ = PendingFrame{};
   wake_.notify_one();
+  if (slam_ && slam_->dense_map()) {
+    std::lock_guard lock(dense_mutex_);
+    // Once, or again for a new map (the session was reset): a pointer compare otherwise.
+    if (!dense_ || &dense_->map() != slam_->dense_map()) {
+      if (dense_) dense_->clear();  // the old map's regions off the page
+      dense_ = std::make_unique<DenseLayer>(slam_->shared_dense_map(), board_, options_.dense);
+    }
+  }
   if (board_.clients() > 0 && seconds_since(last_map_gather_) >= 1.0 / options_.map_rate) gather_map();
 }
 
@@ -208,6 +222,14 @@ void LiveViewer::on_finished() {  // after tracking: not counted as time taken f
     std::lock_guard publish(map_publish_mutex_);
     board_.set_map(std::move(message));
     final_map_published_ = true;
+  }
+  {
+    // The final dense map (finish() fused it again from the final poses), for browsers now and later.
+    std::lock_guard lock(dense_mutex_);
+    if (dense_) {
+      dense_->stop();
+      dense_->update();
+    }
   }
   if (slam_) {
     const PipelineSummary s = slam_->summary();

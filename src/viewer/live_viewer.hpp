@@ -22,6 +22,7 @@
 #include "pipeline/events.hpp"
 #include "slam/keyframe.hpp"
 #include "slam/map_point.hpp"
+#include "viewer/dense_layer.hpp"
 #include "viewer/viewer_board.hpp"
 #include "viewer/viewer_messages.hpp"
 #include "viewer/viewer_server.hpp"
@@ -35,12 +36,14 @@ struct LiveViewerOptions {
   std::string title;                            // what the page shows as the run's name (the dataset)
   std::optional<Trajectory> groundtruth;        // drawn in the map's frame once the live trajectory aligns to it
   std::optional<std::filesystem::path> assets;  // the page's folder (else searched, viewer_assets.hpp)
+  DenseLayerOptions dense;                      // the dense map's layer (when the run has dense.enabled)
 };
 
 /// What the viewer did, for tests and benchmarks.
 struct LiveViewerStats {
   std::uint64_t frames_seen = 0, frames_encoded = 0, frames_sent = 0, maps_encoded = 0;
   double observer_ms_total = 0, observer_ms_max = 0;  // time spent in callbacks on the tracking thread
+  std::optional<DenseLayerStats> dense;                // with a dense map
 };
 
 class LiveViewer : public Observer {
@@ -115,6 +118,8 @@ class LiveViewer : public Observer {
   std::mutex map_publish_mutex_;  // the final map, once on the board, is never replaced by an older one
   bool final_map_published_ = false;
 
+  std::unique_ptr<DenseLayer> dense_;  // made on the first frame of a run with a dense map (tracking thread)
+  mutable std::mutex dense_mutex_;     // dense_ itself, for stats() and stop() from other threads
   std::thread encoder_;
 };
 

@@ -36,11 +36,19 @@ void ViewerBoard::append(std::string message) {
   changed_.notify_all();
 }
 
+void ViewerBoard::set_dense_region(const std::string& key, std::string message) {
+  {
+    std::lock_guard lock(mutex_);
+    dense_[key] = {++dense_version_, std::make_shared<const std::string>(std::move(message))};
+  }
+  changed_.notify_all();
+}
+
 std::vector<Message> ViewerBoard::wait_news(Cursor& cursor, std::chrono::milliseconds timeout) {
   std::unique_lock lock(mutex_);
   const auto has_news = [&] {
     return closed_ || (greeting_ && !cursor.greeted) || cursor.log < log_.size() || cursor.map < map_version_ ||
-           cursor.frame < frame_version_;
+           cursor.dense < dense_version_ || cursor.frame < frame_version_;
   };
   changed_.wait_for(lock, timeout, has_news);
   std::vector<Message> out;
@@ -54,6 +62,11 @@ std::vector<Message> ViewerBoard::wait_news(Cursor& cursor, std::chrono::millise
   if (cursor.map < map_version_) {
     out.push_back(map_);
     cursor.map = map_version_;
+  }
+  if (cursor.dense < dense_version_) {
+    for (const auto& [key, region] : dense_)
+      if (region.version > cursor.dense) out.push_back(region.message);
+    cursor.dense = dense_version_;
   }
   if (cursor.frame < frame_version_) {
     out.push_back(frame_);

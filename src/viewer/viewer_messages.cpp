@@ -1,5 +1,8 @@
 #include "viewer/viewer_messages.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -157,6 +160,28 @@ nlohmann::json map_message(const MapView& m) {
   j["groundtruth"] = xyz(m.groundtruth);
   j["final"] = m.final;
   return j;
+}
+
+nlohmann::json dense_region_message(const DenseRegionView& r) {
+  const double unit = r.size / 8192;
+  std::vector<std::int16_t> xyz;
+  std::vector<std::uint8_t> rgb;
+  xyz.reserve(r.points.size() * 3);
+  rgb.reserve(r.points.size() * 3);
+  for (const dense::SurfacePoint& p : r.points) {
+    for (int a = 0; a < 3; ++a) {
+      const double q = std::round((p.position[a] - r.origin[a]) / unit);
+      xyz.push_back(static_cast<std::int16_t>(std::clamp(q, -32768.0, 32767.0)));
+    }
+    rgb.insert(rgb.end(), p.rgb.begin(), p.rgb.end());
+  }
+  return {{"key", r.key},
+          {"origin", {r.origin.x(), r.origin.y(), r.origin.z()}},
+          {"unit", unit},
+          {"cell", r.cell},
+          {"count", r.points.size()},
+          {"xyz", base64(xyz.data(), xyz.size() * sizeof(std::int16_t))},
+          {"rgb", base64(rgb.data(), rgb.size())}};
 }
 
 std::vector<Eigen::Vector3d> positions(const Trajectory& trajectory) {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/trajectory.hpp"
+#include "dense/tsdf_volume.hpp"
 #include "slam/tracking.hpp"
 
 namespace varslam::viewer {
@@ -73,10 +74,22 @@ struct MapView {
   bool final = false;                                                // after finish(): the final trajectory and map
 };
 
+/// One region of the dense map's layer: its surface points (none: the region is empty now) relative to the region's
+/// corner, as int16 x y z triples in steps of `unit` metres (region edge / 8192: a fraction of a millimetre, and room
+/// for the points that sit just past the region's far side), and their colours as RGB bytes.
+struct DenseRegionView {
+  std::string key;                    // names the region (its integer index "i,j,k")
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();  // the region's first corner, world frame
+  double size = 0;                    // the region's edge (m)
+  double cell = 0;                    // the points' spacing (m), how large the page draws them
+  std::vector<dense::SurfacePoint> points;
+};
+
 std::string base64(const void* data, std::size_t bytes);
 /// The frame message; `image`: the frame's picture (colour or gray), sent as JPEG at most `max_width` wide.
 nlohmann::json frame_message(const FrameView& frame, const cv::Mat& image, int max_width = 640, int jpeg_quality = 75);
 nlohmann::json map_message(const MapView& map);
+nlohmann::json dense_region_message(const DenseRegionView& region);
 /// Camera-to-world poses as float32 x y z triples.
 std::vector<Eigen::Vector3d> positions(const Trajectory& trajectory);
 /// Ground truth moved into the estimate's frame by the rigid alignment of `estimate` to it; empty when fewer than

@@ -173,6 +173,12 @@ TEST(ApiSlam, TheDenseMapIsASnapshotAnyThreadMayRead) {
       for (const auto& t : d->triangles)
         for (const auto i : t) ASSERT_LT(static_cast<std::size_t>(i), d->vertices.size());
       ++reads;
+      varslam::DenseMapRequest surface;  // as a periodic publisher asks (the ROS node's ~dense_map)
+      surface.mesh = surface.occupancy = false;
+      surface.surface = true;
+      const auto s = slam.dense_map_snapshot(surface);
+      ASSERT_EQ(s->surface.size(), s->surface_colours.size());
+      ASSERT_TRUE(s->vertices.empty() && s->free.empty());
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
   });
@@ -189,6 +195,19 @@ TEST(ApiSlam, TheDenseMapIsASnapshotAnyThreadMayRead) {
   EXPECT_EQ(d->colours.size(), d->vertices.size());
   EXPECT_GT(d->occupied.size(), 1000u);
   EXPECT_GT(d->free.size(), d->occupied.size());
+  // The surface alone: at one point per voxel cell it is the mesh's vertices; thinned, fewer.
+  varslam::DenseMapRequest request;
+  request.mesh = request.occupancy = false;
+  request.surface = true;
+  request.surface_cell_voxels = 1;
+  EXPECT_EQ(slam.dense_map_snapshot(request)->surface.size(), d->vertices.size());
+  request.surface_cell_voxels = 2;
+  const std::size_t thinned = slam.dense_map_snapshot(request)->surface.size();
+  EXPECT_LT(thinned * 2, d->vertices.size());
+  EXPECT_GT(thinned * 8, d->vertices.size());
+  request.surface_cell_voxels = 3;
+  EXPECT_THAT([&] { slam.dense_map_snapshot(request); },
+              ::testing::ThrowsMessage<varslam::ConfigError>(HasSubstr("surface_cell_voxels")));
 
   varslam::Slam without(sequence().config);
   without.track(sequence().frames[0].bgr, sequence().frames[0].depth, sequence().frames[0].timestamp);

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <octomap/OcTree.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -10,6 +11,7 @@
 #include "core/error.hpp"
 #include "dense/dense_mapper.hpp"
 #include "dense/mover_mask.hpp"
+#include "dense/surface_tracker.hpp"
 #include "dense/tsdf_volume.hpp"
 #include "io/settings_registry.hpp"
 #include "report/dense_bench.hpp"
@@ -175,6 +177,65 @@ TEST(DenseMapper, TheMapFollowsAKeyframeWhosePoseChanged) {
     EXPECT_EQ(vertices_near_z(m, 2.0f, 0.01f), 0u) << "threaded " << threaded;
     EXPECT_GT(vertices_near_z(m, 2.3f, 0.01f), 1000u) << "threaded " << threaded;
   }
+}
+
+// A live view's reader: the surface it follows is the mesh's (at cell 1), each update reads only what changed,
+// and the fusion it does for the view in deterministic mode leaves the final map as it would be without it.
+TEST(SurfaceTracker, FollowsTheMapWithTheMeshVerticesAndResendsOnlyTheChangedRegions) {
+  const PinholeCamera c = small_camera();
+  DenseConfig cfg;
+  cfg.pixel_step = 1;
+  const auto keyframe = [&](double x) {
+    DenseKeyframe kf;
+    kf.depth = wall_depth(c, 2.0f);
+    kf.pose = [x] {
+      Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+      T.translation().x() = x;
+      return T;
+    };
+    return kf;
+  };
+  DenseMapper previewed(cfg, c, false), plain(cfg, c, false);
+  previewed.add(keyframe(0));
+  plain.add(keyframe(0));
+  SurfaceTracker fine(1, cfg.tsdf.voxel_size), coarse(2, cfg.tsdf.voxel_size);
+  EXPECT_TRUE(fine.update(previewed).empty());  // nothing fused yet
+  int steps = 0;
+  while (previewed.preview_step()) ++steps;
+  EXPECT_EQ(steps, 1);
+  const std::vector<SurfaceTracker::RegionKey> first = fine.update(previewed);
+  EXPECT_GT(first.size(), 4u);
+  coarse.update(previewed);
+  EXPECT_GT(fine.point_count(), 5000u);
+  // A flat wall thinned to one point per 2x2x2 voxels: about a quarter of the points.
+  EXPECT_GT(coarse.point_count() * 6, fine.point_count());
+  EXPECT_LT(coarse.point_count() * 3, fine.point_count());
+  EXPECT_TRUE(fine.update(previewed).empty());  // nothing changed since
+
+  // A keyframe 4 m to the side sees another part of the wall: only regions there change.
+  previewed.add(keyframe(4));
+  plain.add(keyframe(4));
+  while (previewed.preview_step()) {
+  }
+  const std::vector<SurfaceTracker::RegionKey> second = fine.update(previewed);
+  ASSERT_FALSE(second.empty());
+  for (const auto r : second)
+    EXPECT_GE(SurfaceTracker::region_index(r).x() * fine.region_size(), 4.0 - 1.5) << "a region far from the change";
+  for (const auto r : first) EXPECT_TRUE(std::find(second.begin(), second.end(), r) == second.end());
+
+  // The map written at the end is the same with and without the view's fusions; the tracker follows the rebuild.
+  previewed.finish();
+  plain.finish();
+  const Mesh a = previewed.mesh(), b = plain.mesh();
+  ASSERT_EQ(a.vertices.size(), b.vertices.size());
+  for (std::size_t i = 0; i < a.vertices.size(); ++i) ASSERT_EQ(a.vertices[i], b.vertices[i]);
+  EXPECT_EQ(a.triangles, b.triangles);
+  EXPECT_FALSE(previewed.preview_step());
+  EXPECT_FALSE(fine.update(previewed).empty());
+  EXPECT_EQ(fine.point_count(), a.vertices.size());
+  EXPECT_EQ(previewed.stats().integrations, plain.stats().integrations);  // the view's fusions are counted apart
+  EXPECT_EQ(previewed.stats().preview_fusions, 2u);
+  EXPECT_THROW(SurfaceTracker(3, 0.02), std::invalid_argument);
 }
 
 TEST(DenseOutputs, PlyAndOctomapFilesReadBack) {

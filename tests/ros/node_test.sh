@@ -2,7 +2,8 @@
 # varslam_node under a real roscore (started here on a free loopback port, stopped at the end), fed by `rosbag play`
 # of a bag written from a synthetic sequence at 1x: every frame gets a pose on ~odometry, TF is published, the
 # poses are as accurate as a direct real-time run of the folder (within that run's spread over repeats), the
-# services work, and a bad parameter stops the node with its message (exit 2).
+# services work, a bad parameter stops the node with its message (exit 2), and with ~dense/enabled the dense map's
+# surface comes out on ~dense_map.
 # Usage: node_test.sh BUILD_DIR
 set -euo pipefail
 build=$1
@@ -53,6 +54,11 @@ set -e
 [[ $code -eq 2 ]] || fail "bad parameter: exit $code, expected 2"
 grep -q "tracking.kernel" "$work/bad.log" || fail "bad parameter: no message naming tracking.kernel"
 grep -q "bogus" "$work/bad.log" || fail "bad parameter: the message does not name the value"
+set +e
+timeout 30 "$bin/varslam_node" __name:=bad_dense _dense_map_cell:=3 > "$work/bad_dense.log" 2>&1
+code=$?
+set -e
+[[ $code -eq 2 ]] && grep -q "dense_map_cell" "$work/bad_dense.log" || fail "bad ~dense_map_cell: exit $code, $(cat "$work/bad_dense.log")"
 
 # The node as a user starts it: the TUM launch file, found through ROS_PACKAGE_PATH (build/share/varslam).
 ROS_PACKAGE_PATH=$build/share roslaunch varslam tum.launch person_detector:=none map_file:="$work/node.map" \
@@ -140,7 +146,7 @@ PY
 # world -> kinect stands for a robot's odometry, so map -> world is the (near constant) alignment of the map to it.
 "$bin/varslam_node" __name:=varslam_odom rgb/image:=/camera/rgb/image_color depth/image:=/camera/depth/image \
   rgb/camera_info:=/camera/rgb/camera_info _semantic/detector:=none _odom_frame:=world _camera_frame:=kinect \
-  > "$work/node_odom.log" 2>&1 &
+  _dense/enabled:=true _dense_map_rate:=2 > "$work/node_odom.log" 2>&1 &
 node=$!
 pids+=($node)
 rosbag record -O "$work/odom.bag" /tf > /dev/null 2>&1 &
@@ -152,6 +158,29 @@ for _ in $(seq 100); do
 done
 rosbag play -q -d 1 -u 2 "$work/seq.bag" > /dev/null 2>&1
 sleep 2
+# The dense map's surface on ~dense_map (latched, at ~dense_map_rate): coloured points in the map frame. The dense
+# map's thread runs at idle priority, so on a busy machine it may take a few seconds to fuse the keyframes.
+/usr/bin/python3 - <<'PY' || fail "dense map topic: $(tail -5 "$work/node_odom.log")"
+import time, rospy
+from sensor_msgs.msg import PointCloud2
+rospy.init_node('dense_check', anonymous=True, disable_signals=True)
+deadline, best = time.time() + 30, None
+while time.time() < deadline:
+    try:
+        m = rospy.wait_for_message('/varslam_odom/dense_map', PointCloud2, timeout=max(0.1, deadline - time.time()))
+    except rospy.ROSException:
+        break
+    best = m
+    if m.width * m.height >= 1000:
+        break
+    time.sleep(0.5)  # latched: the same cloud again until the next one
+assert best is not None, "no message on /varslam_odom/dense_map"
+n = best.width * best.height
+fields = [f.name for f in best.fields]
+print("dense map: %d points in frame %s, fields %s" % (n, best.header.frame_id, fields))
+assert n >= 1000, "%d points" % n
+assert best.header.frame_id == 'map' and fields == ['x', 'y', 'z', 'rgb'], (best.header.frame_id, fields)
+PY
 pkill -INT -P "$rec" || true; kill -INT "$rec" 2>/dev/null || true; wait "$rec" || true
 kill -INT "$node"; wait "$node" || fail "the odom node did not stop cleanly"
 for _ in $(seq 50); do [[ -f $work/odom.bag ]] && break; sleep 0.1; done

@@ -8,6 +8,7 @@ import puppeteer from 'puppeteer-core';
 const [url, screenshot, ...rest] = process.argv.slice(2);
 const finished = rest.includes('--finished');
 const live = rest.includes('--live');
+const dense = rest.includes('--dense');
 
 const browser = await puppeteer.launch({
   executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
@@ -38,7 +39,33 @@ try {
     await page.waitForFunction(() => viewerStatus.done, { timeout: 600000, polling: 100 });
     framesBeforeEnd = await page.evaluate(() => viewerStatus.framesBeforeDone);
   }
+  if (dense) await page.waitForFunction(() => viewerStatus.densePoints > 0, { timeout: 30000, polling: 100 });
   await new Promise((r) => setTimeout(r, 700));  // the last render and image decode
+  // Pixels of the 3-D view off the background colour.
+  const scenePixels = () => page.evaluate(() => {
+    const scene = document.querySelector('#scene canvas');
+    const copy = document.createElement('canvas');
+    copy.width = scene.width;
+    copy.height = scene.height;
+    const g = copy.getContext('2d');
+    g.drawImage(scene, 0, 0);
+    const s = g.getImageData(0, 0, copy.width, copy.height).data;
+    let n = 0;
+    for (let i = 0; i < s.length; i += 4) if (Math.abs(s[i] - 0x15) + Math.abs(s[i + 1] - 0x18) + Math.abs(s[i + 2] - 0x1c) >= 60) ++n;
+    return n;
+  });
+  let denseToggle = null;
+  if (dense) {
+    const render = () => new Promise((r) => setTimeout(r, 400));
+    const withLayer = await scenePixels();
+    await page.click('#show-dense');
+    await render();
+    const without = await scenePixels();
+    const hidden = await page.evaluate(() => !viewerStatus.denseVisible);
+    await page.click('#show-dense');
+    await render();
+    denseToggle = { withLayer, without, hidden, shownAgain: await page.evaluate(() => viewerStatus.denseVisible) };
+  }
   const result = await page.evaluate(() => {
     const near = (d, i, rgb) => Math.abs(d[i] - rgb[0]) + Math.abs(d[i + 1] - rgb[1]) + Math.abs(d[i + 2] - rgb[2]) < 60;
     const scene = document.querySelector('#scene canvas');
@@ -62,6 +89,7 @@ try {
              events: document.getElementById('events').children.length };
   });
   result.pageErrors = errors;
+  result.denseToggle = denseToggle;
   result.framesBeforeEnd = framesBeforeEnd;
   await page.screenshot({ path: screenshot });
   console.log(JSON.stringify(result));
@@ -71,6 +99,11 @@ try {
     ['no page errors', errors.length === 0],
   ];
   if (live) checks.push(['frames streamed while the run went on', framesBeforeEnd >= 5]);
+  if (dense) {
+    checks.push(['dense layer received', result.densePoints > 1000 && result.denseRegions > 5]);
+    checks.push(['dense layer drawn: hiding it clears pixels', denseToggle.hidden && denseToggle.withLayer > denseToggle.without + 5000]);
+    checks.push(['dense layer shown again', denseToggle.shownAgain]);
+  }
   if (!finished) {
     checks.push(['keypoints drawn over the image', result.drawnMarks > 50 && result.inlierPixels > 200]);
     checks.push(['state line shows tracking', /tracking|lost|initializing/.test(result.stateLine)]);

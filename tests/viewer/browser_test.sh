@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# The viewer as a user sees it: `varslam run --viewer` on a short synthetic walking scene (real-time, paced, started
-# once the browser is connected) and `varslam view` on the finished run, each opened in headless chromium
+# The viewer as a user sees it: `varslam run --viewer --dense-map` on a short synthetic walking scene (real-time,
+# paced, started once the browser is connected; the dense map's layer drawn and toggled) and `varslam view` on the
+# finished run, each opened in headless chromium
 # (browser_check.mjs checks the drawn page). Screenshots: <build>/viewer-screenshots/.
 # Usage: browser_test.sh SOURCE_DIR BUILD_DIR
 set -euo pipefail
@@ -46,11 +47,11 @@ url_of() {  # log file -> the URL the viewer printed
 
 echo "[browser] live run"
 "$bin" run -d "$work/walk" -o "$work/run" --realtime --pace --viewer --viewer-wait --viewer-hold -q \
-  --set semantic.detector=boxes >"$work/run.out" 2>"$work/run.err" &
+  --dense-map --set semantic.detector=boxes >"$work/run.out" 2>"$work/run.err" &
 run_pid=$!
 pids+=("$run_pid")
 url=$(url_of "$work/run.err")
-node "$npmdir/browser_check.mjs" "$url" "$shots/live_walking.png" --live | tee "$work/live.json"
+node "$npmdir/browser_check.mjs" "$url" "$shots/live_walking.png" --live --dense | tee "$work/live.json"
 kill -INT "$run_pid"
 wait "$run_pid" || fail "varslam run --viewer exited with $? after Ctrl+C while holding"
 grep -q "keeps showing it until Ctrl+C" "$work/run.err" || fail "the run did not say it holds the viewer"

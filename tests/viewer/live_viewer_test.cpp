@@ -5,6 +5,8 @@
 
 #include <atomic>
 #include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
 
@@ -30,12 +32,32 @@ std::string file_text(const fs::path& f) {
   return s.str();
 }
 
-run::RunSummary run_walking(const std::string& name, std::vector<Observer*> observers) {
+run::RunSummary run_walking(const std::string& name, std::vector<Observer*> observers, bool dense = false) {
   run::RunOptions ro;
   ro.progress = false;
   ro.observers = std::move(observers);
   const fs::path out = fs::temp_directory_path() / ("varslam_viewer_" + name + "_" + std::to_string(::getpid()));
-  return slam::e2e::run_with(walking_sequence(), out, ro, {"semantic.detector=boxes"});
+  std::vector<std::string> settings{"semantic.detector=boxes"};
+  if (dense) settings.push_back("dense.enabled=true");
+  return slam::e2e::run_with(walking_sequence(), out, ro, settings);
+}
+
+// The data lines of every server-sent event `name` in a stream, parsed.
+std::vector<nlohmann::json> events_named(const std::string& stream, const std::string& name) {
+  std::vector<nlohmann::json> out;
+  const std::string head = "event: " + name + "\ndata: ";
+  for (std::size_t at = stream.find(head); at != std::string::npos; at = stream.find(head, at + 1)) {
+    const std::size_t begin = at + head.size(), end = stream.find('\n', begin);
+    if (end == std::string::npos) break;  // cut off by the end of the read
+    out.push_back(nlohmann::json::parse(stream.substr(begin, end - begin)));
+  }
+  return out;
+}
+
+std::size_t base64_bytes(const std::string& b64) {
+  std::size_t pad = 0;
+  for (auto it = b64.rbegin(); it != b64.rend() && *it == '='; ++it) ++pad;
+  return b64.size() / 4 * 3 - pad;
 }
 
 /// A browser stand-in: reads /events on its own thread until told to stop.
@@ -96,6 +118,43 @@ TEST(LiveViewer, TheTrajectoryIsByteIdenticalWithAndWithoutTheViewerAndABrowserC
   EXPECT_LE(s.frames_encoded, s.frames_seen);
   EXPECT_GE(s.maps_encoded, 1u);
   browser.finish();
+}
+
+// The dense map's layer: regions of surface points while the run goes on (deterministic mode: the layer fuses the
+// keyframes for the view itself) and the final map at the end; the files written are those of a run without it.
+TEST(LiveViewer, TheDenseLayerSendsWellFormedRegionsAndLeavesTheRunsFilesAsTheyWere) {
+  const run::RunSummary plain = run_walking("dense_plain", {}, true);
+  LiveViewerOptions o;
+  o.dense.rate = 20;  // the test's run takes a few seconds: update often
+  LiveViewer viewer(o);
+  EventReader browser(viewer.port());
+  ASSERT_TRUE(browser.wait_for("event: hello", 5s));
+  const run::RunSummary watched = run_walking("dense_watched", {&viewer}, true);
+  for (const char* f : {"CameraTrajectory.txt", "dense_mesh.ply", "dense_map.bt"})
+    EXPECT_EQ(file_text(plain.out_dir / f), file_text(watched.out_dir / f)) << f;
+  ASSERT_TRUE(browser.wait_for("event: done", 10s));
+  std::this_thread::sleep_for(300ms);  // the last regions through the stream
+  browser.finish();
+  const std::vector<nlohmann::json> regions = events_named(browser.text(), "dense");
+  ASSERT_FALSE(regions.empty());
+  std::map<std::string, std::size_t> newest;  // region -> points, as the page keeps them
+  for (const nlohmann::json& r : regions) {
+    ASSERT_TRUE(r.contains("key") && r.contains("origin") && r.contains("unit") && r.contains("cell"));
+    const std::size_t n = r["count"];
+    EXPECT_EQ(base64_bytes(r["xyz"]), n * 3 * sizeof(std::int16_t));
+    EXPECT_EQ(base64_bytes(r["rgb"]), n * 3);
+    EXPECT_GT(r["unit"].get<double>(), 0);
+    EXPECT_DOUBLE_EQ(r["cell"].get<double>(), 0.04);  // 2-cm voxels, two per cell
+    newest[r["key"]] = n;
+  }
+  std::size_t points = 0;
+  for (const auto& [key, n] : newest) points += n;
+  const LiveViewerStats s = viewer.stats();
+  ASSERT_TRUE(s.dense.has_value());
+  EXPECT_GE(s.dense->updates, 2u);  // during the run and the final one
+  EXPECT_EQ(s.dense->points, points);
+  EXPECT_GT(points, 2000u);
+  EXPECT_LE(s.dense->max_update_bytes, 16u * 1024 * 1024);
 }
 
 TEST(LiveViewer, WithoutABrowserNothingIsEncodedButTheFinalStateWaitsForOne) {

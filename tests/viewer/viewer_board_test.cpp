@@ -55,6 +55,22 @@ TEST(ViewerBoard, ALateOrReconnectingClientStartsFromTheCurrentStateAndTheWholeL
   EXPECT_EQ(texts(b.wait_news(fresh, 1ms)), (std::vector<std::string>{"hello", "loop", "map2", "frame7"}));
 }
 
+TEST(ViewerBoard, DenseRegionsGoOutWhenTheyChangeInTheirNewestVersionAndWholeToALateClient) {
+  ViewerBoard b;
+  b.set_greeting("hello");
+  ViewerBoard::Cursor c;
+  (void)b.wait_news(c, 1ms);
+  b.set_dense_region("0,0,0", "a1");
+  b.set_dense_region("0,0,1", "b1");
+  EXPECT_EQ(texts(b.wait_news(c, 1ms)), (std::vector<std::string>{"a1", "b1"}));
+  b.set_dense_region("0,0,1", "b2");
+  b.set_dense_region("0,0,1", "b3");  // a slow client skips b2
+  EXPECT_EQ(texts(b.wait_news(c, 1ms)), (std::vector<std::string>{"b3"}));
+  EXPECT_TRUE(b.wait_news(c, 1ms).empty());
+  ViewerBoard::Cursor late;
+  EXPECT_EQ(texts(b.wait_news(late, 1ms)), (std::vector<std::string>{"hello", "a1", "b3"}));
+}
+
 TEST(ViewerBoard, AWaitingClientWakesOnNewsAndOnClose) {
   ViewerBoard b;
   b.set_greeting("hello");

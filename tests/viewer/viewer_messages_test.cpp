@@ -105,5 +105,35 @@ TEST(ViewerMessages, GroundTruthIsBroughtIntoTheMapFrame) {
   EXPECT_TRUE(groundtruth_in_map_frame(gt, {}).empty());
 }
 
+// The dense layer's region: int16 offsets from the region's corner in steps of `unit`, colours as bytes.
+TEST(ViewerMessages, DenseRegionMessageCarriesEveryPointWithinHalfAUnit) {
+  DenseRegionView r;
+  r.key = "1,-2,3";
+  r.size = 0.64;
+  r.origin = Eigen::Vector3d(0.64, -1.28, 1.92);
+  r.cell = 0.04;
+  r.points.push_back({Eigen::Vector3f(0.7f, -1.2f, 2.0f), {10, 20, 30}});
+  r.points.push_back({Eigen::Vector3f(1.3f, -0.63f, 2.57f), {255, 0, 128}});  // just past the far side
+  const nlohmann::json j = dense_region_message(r);
+  EXPECT_EQ(j["key"], "1,-2,3");
+  EXPECT_EQ(j["count"], 2);
+  EXPECT_DOUBLE_EQ(j["unit"].get<double>(), 0.64 / 8192);
+  EXPECT_DOUBLE_EQ(j["cell"].get<double>(), 0.04);
+  const std::vector<unsigned char> xyz = unbase64(j["xyz"]), rgb = unbase64(j["rgb"]);
+  ASSERT_EQ(xyz.size(), 2u * 3 * sizeof(std::int16_t));
+  ASSERT_EQ(rgb.size(), 6u);
+  std::vector<std::int16_t> q(6);
+  std::memcpy(q.data(), xyz.data(), xyz.size());
+  const double unit = j["unit"];
+  for (std::size_t i = 0; i < 2; ++i)
+    for (int a = 0; a < 3; ++a)
+      EXPECT_NEAR(j["origin"][a].get<double>() + q[i * 3 + static_cast<std::size_t>(a)] * unit,
+                  r.points[i].position[a], unit / 2 + 1e-6);
+  EXPECT_EQ(std::vector<unsigned char>(rgb.begin(), rgb.end()),
+            (std::vector<unsigned char>{10, 20, 30, 255, 0, 128}));
+  r.points.clear();  // a region emptied: the message says so
+  EXPECT_EQ(dense_region_message(r)["count"], 0);
+}
+
 }  // namespace
 }  // namespace varslam::viewer
