@@ -45,6 +45,15 @@ RgbdFrame make_frame(double t) {
   return f;
 }
 
+// The person's box (a little larger than the person) in the frame at time t.
+Detections person_detected_at(double t) {
+  Detection d;
+  d.timestamp = t;
+  d.label = "person";
+  d.box = cv::Rect2f(static_cast<float>(person_x(t) - 10), 110, 110, 220);
+  return {d};
+}
+
 // "Detects" the person where make_frame put it. Frames after the first wait for the gate, so the test controls
 // exactly which result is the freshest.
 class ScriptedDetector final : public Detector {
@@ -52,11 +61,7 @@ class ScriptedDetector final : public Detector {
   explicit ScriptedDetector(std::atomic<bool>* gate) : gate_(gate) {}
   Detections detect(const cv::Mat&, double t) override {
     while (t > 0.0 && !gate_->load()) std::this_thread::sleep_for(std::chrono::milliseconds(2));
-    Detection d;
-    d.timestamp = t;
-    d.label = "person";
-    d.box = cv::Rect2f(static_cast<float>(person_x(t) - 10), 110, 110, 220);
-    return {d};
+    return person_detected_at(t);
   }
   std::string name() const override { return "scripted"; }
 
@@ -143,11 +148,7 @@ class SlowDetector final : public Detector {
   Detections detect(const cv::Mat&, double t) override {
     std::this_thread::sleep_for(std::chrono::milliseconds(ms_));
     ++runs_on_[static_cast<int>(t)];
-    Detection d;
-    d.timestamp = t;
-    d.label = "person";
-    d.box = cv::Rect2f(static_cast<float>(person_x(t) - 10), 110, 110, 220);
-    return {d};
+    return person_detected_at(t);
   }
   std::string name() const override { return "slow"; }
   std::map<int, int> runs_on_;  // frame -> runs; read after the masker waited for the detector
