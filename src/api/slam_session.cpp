@@ -341,7 +341,7 @@ std::shared_ptr<const DenseMapSnapshot> Slam::dense_map_snapshot(const DenseMapR
   }
   auto out = std::make_shared<DenseMapSnapshot>();
   if (!d) return out;
-  // The dense map's own lock from here: tracking goes on meanwhile.
+  // From the dense map's shared copy from here: neither tracking nor its fusion waits for this reader.
   out->voxel_size = d->config().tsdf.voxel_size;
   out->keyframes = d->stats().keyframes;
   if (request.mesh) {

@@ -90,6 +90,8 @@ cv::Mat max_pool(const cv::Mat& m, int step, int w, int h) {
 
 DenseMapper::DenseMapper(const DenseConfig& cfg, const PinholeCamera& camera, bool threaded)
     : cfg_(cfg), camera_(scaled(camera, std::max(1, cfg.pixel_step))), threaded_(threaded), volume_(cfg.tsdf) {
+  std::lock_guard lock(fusion_mutex_);
+  publish_locked();
   if (threaded_) thread_ = std::thread([this] { worker(); });
 }
 
@@ -98,8 +100,18 @@ DenseMapper::~DenseMapper() {
     std::lock_guard lock(queue_mutex_);
     stop_ = true;
   }
+  stop_worker();
+}
+
+void DenseMapper::stop_worker() {
+  cancel_ = true;
   wake_.notify_all();
-  if (thread_.joinable()) thread_.join();
+  if (!thread_.joinable()) return;
+  // The worker runs at idle priority and may be kept off a busy CPU for long: back to normal priority so it sees
+  // the cancel at once (allowed where the limits let it; else it sees it when next scheduled).
+  sched_param normal{};
+  (void)pthread_setschedparam(thread_.native_handle(), SCHED_OTHER, &normal);
+  thread_.join();
 }
 
 DenseMapper::Stored DenseMapper::prepare(DenseKeyframe kf) const {
@@ -163,39 +175,33 @@ bool DenseMapper::moved(const Stored& s, const Eigen::Isometry3d& now) const {
   return dt > cfg_.reintegrate_m || da > cfg_.reintegrate_deg;
 }
 
-void DenseMapper::fuse_locked(Stored& s, double* ms, bool preview) {
+bool DenseMapper::fuse_locked(Stored& s, bool preview, const std::atomic<bool>* cancel) {
   const auto t0 = std::chrono::steady_clock::now();
   const Eigen::Isometry3d now = s.pose();
   if (s.fused) {
-    volume_.integrate(view_of(s, s.fused_pose), -1);
+    if (volume_.integrate(view_of(s, s.fused_pose), -1, cancel).cancelled) return false;
     if (!preview) ++stats_.reintegrations;
   }
-  const IntegrationStats st = volume_.integrate(view_of(s, now), +1);
+  const IntegrationStats st = volume_.integrate(view_of(s, now), +1, cancel);
+  if (st.cancelled) return false;
   used_pixels_ += st.pixels_used;
   moving_pixels_ += st.pixels_moving;
   s.fused = true;
   s.fused_pose = now;
-  const double t = ms_since(t0);
   if (preview) {
     ++stats_.preview_fusions;
   } else {
     ++stats_.integrations;
-    stats_.integrate_ms.push_back(t);
+    stats_.integrate_ms.push_back(ms_since(t0));
   }
-  if (ms) *ms += t;
+  return true;
 }
 
-bool DenseMapper::fuse_one_locked(bool preview) {
-  if (next_to_fuse_ < store_.size()) {
-    fuse_locked(store_[next_to_fuse_++], nullptr, preview);
-    return true;
-  }
+bool DenseMapper::fuse_one_locked(bool preview, const std::atomic<bool>* cancel) {
+  if (next_to_fuse_ < store_.size()) return fuse_locked(store_[next_to_fuse_++], preview, cancel);
   // Then the keyframes whose pose moved since they were fused (one at a time: new keyframes come first).
   for (Stored& s : store_)
-    if (s.fused && moved(s, s.pose())) {
-      fuse_locked(s, nullptr, preview);
-      return true;
-    }
+    if (s.fused && moved(s, s.pose())) return fuse_locked(s, preview, cancel);
   return false;
 }
 
@@ -204,16 +210,27 @@ void DenseMapper::rebuild_locked() {
   used_pixels_ = moving_pixels_ = 0;
   for (Stored& s : store_) {
     s.fused = false;
-    fuse_locked(s, nullptr);
+    fuse_locked(s, false);
   }
   next_to_fuse_ = store_.size();
   ++stats_.rebuilds;
   dirty_ = false;
 }
 
+void DenseMapper::publish_locked() {
+  auto p = std::make_shared<Published>();
+  p->volume = volume_.share();
+  p->stats = stats_;
+  p->stats.blocks = volume_.block_count();
+  const std::size_t all = used_pixels_ + moving_pixels_;
+  p->stats.moving_pixel_share = all ? static_cast<double>(moving_pixels_) / static_cast<double>(all) : 0.0;
+  std::lock_guard lock(published_mutex_);
+  published_ = std::move(p);
+}
+
 void DenseMapper::worker() {
   // Below tracking and local mapping: the dense map runs only on a core nothing else wants (SCHED_IDLE; else at nice
-  // +10). On a busy machine it waits, not the pose; finish() fuses what is left.
+  // +10). On a busy machine it waits, not the pose, and no reader waits for it; finish() fuses what is left.
   sched_param idle{};
   if (pthread_setschedparam(pthread_self(), SCHED_IDLE, &idle) != 0)
     setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), 10);
@@ -231,11 +248,13 @@ void DenseMapper::worker() {
     {
       std::optional<Stored> s;
       if (kf) s = prepare(std::move(*kf));  // no lock: the mover mask and the downsampling take a while
-      std::lock_guard lock(mutex_);
+      std::lock_guard lock(fusion_mutex_);
       if (s) store_.push_back(std::move(*s));
-      worked = fuse_one_locked(false);
+      worked = fuse_one_locked(false, &cancel_);
+      if (cancel_) return;  // finish() fuses everything again; the destructor wants nothing more
+      if (worked) publish_locked();
     }
-    if (worked) continue;  // readers (mesh(), stats()) get the volume's lock between keyframes
+    if (worked) continue;
     std::unique_lock lock(queue_mutex_);
     wake_.wait_for(lock, std::chrono::milliseconds(200), [&] { return stop_ || !pending_.empty(); });
   }
@@ -247,9 +266,8 @@ void DenseMapper::finish() {
     if (finished_) return;
     stop_ = true;
   }
-  wake_.notify_all();
-  if (thread_.joinable()) thread_.join();
-  std::lock_guard lock(mutex_);
+  stop_worker();
+  std::lock_guard lock(fusion_mutex_);
   std::deque<DenseKeyframe> left;
   {
     std::lock_guard queue(queue_mutex_);
@@ -261,25 +279,37 @@ void DenseMapper::finish() {
   const auto t0 = std::chrono::steady_clock::now();
   rebuild_locked();
   stats_.final_rebuild_ms = ms_since(t0);
+  publish_locked();
+}
+
+std::shared_ptr<const TsdfVolume> DenseMapper::snapshot() const {
+  std::lock_guard lock(published_mutex_);
+  return published_->volume;
+}
+
+void DenseMapper::bring_up_to_date() {
+  if (threaded_) return;  // the worker keeps the snapshot current
+  std::lock_guard lock(fusion_mutex_);
+  take_arrived_locked();
+  if (dirty_) {
+    rebuild_locked();
+    publish_locked();
+  }
 }
 
 Mesh DenseMapper::mesh() {
-  std::lock_guard lock(mutex_);
-  take_arrived_locked();
-  if (!threaded_ && dirty_) rebuild_locked();
-  return volume_.extract_mesh();
+  bring_up_to_date();
+  return snapshot()->extract_mesh();
 }
 
 std::vector<OccupancyVoxel> DenseMapper::occupancy() {
-  std::lock_guard lock(mutex_);
-  take_arrived_locked();
-  if (!threaded_ && dirty_) rebuild_locked();
-  return volume_.occupancy();
+  bring_up_to_date();
+  return snapshot()->occupancy();
 }
 
 bool DenseMapper::preview_step() {
   if (threaded_) return false;
-  std::lock_guard lock(mutex_);
+  std::lock_guard lock(fusion_mutex_);
   {
     std::lock_guard queue(queue_mutex_);
     if (finished_) return false;
@@ -287,35 +317,18 @@ bool DenseMapper::preview_step() {
   take_arrived_locked();
   if (!fuse_one_locked(true)) return false;
   dirty_ = true;  // mesh() and occupancy() still fuse everything afresh: the same input gives the same map
-  return true;
-}
-
-DenseMapper::Changes DenseMapper::changes_since(std::uint64_t stamp) const {
-  std::lock_guard lock(mutex_);
-  return {volume_.epoch(), volume_.stamp(), volume_.changed_since(stamp)};
-}
-
-bool DenseMapper::read_surface(const std::vector<TsdfVolume::BlockKey>& keys, std::uint64_t epoch,
-                               std::vector<std::vector<SurfacePoint>>& out) const {
-  std::lock_guard lock(mutex_);
-  if (volume_.epoch() != epoch) return false;
-  for (const TsdfVolume::BlockKey k : keys) {
-    out.emplace_back();
-    volume_.block_surface(k, out.back());
-  }
+  publish_locked();
   return true;
 }
 
 DenseStats DenseMapper::stats() const {
-  std::lock_guard lock(mutex_);
-  DenseStats s = stats_;
+  DenseStats s;
   {
-    std::lock_guard queue(queue_mutex_);
-    s.keyframes = keyframes_;
+    std::lock_guard lock(published_mutex_);
+    s = published_->stats;
   }
-  s.blocks = volume_.block_count();
-  const std::size_t all = used_pixels_ + moving_pixels_;
-  s.moving_pixel_share = all ? static_cast<double>(moving_pixels_) / static_cast<double>(all) : 0.0;
+  std::lock_guard queue(queue_mutex_);
+  s.keyframes = keyframes_;
   return s;
 }
 

@@ -8,12 +8,15 @@
 //    dense.reintegrate_deg since it was fused. finish() fuses everything again from the final poses, so the map
 //    written at the end agrees with the final trajectory in both modes.
 // Owns its keyframe store and volume; add() and finish() from one thread, the readers from any. add() takes only
-// the queue's lock, never the volume's: the tracking thread does not wait for a fusion or a reader.
+// the queue's lock, never the volume's: the tracking thread does not wait for a fusion or a reader. Readers get a
+// shared copy of the volume as last fused (snapshot()): they wait for neither.
 #include <Eigen/Geometry>
+#include <atomic>
 #include <condition_variable>
 #include <deque>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <mutex>
 #include <thread>
 #include <vector>
@@ -80,21 +83,13 @@ class DenseMapper {
   std::vector<OccupancyVoxel> occupancy();
   DenseStats stats() const;
 
-  // For a live view that follows the map as it grows (dense/surface_tracker.hpp); each call holds the volume's lock
-  // for one keyframe's fusion or a few blocks' reading at most.
-  /// Deterministic mode: fuses one keyframe not fused yet, else one whose pose moved, from its current pose; false
-  /// when there is nothing to do. What finish() writes does not change (it fuses every keyframe again). Real-time
-  /// mode: false (the worker does this).
+  /// Deterministic mode: fuses one keyframe not fused yet, else one whose pose moved, from its current pose, for a
+  /// live view; false when there is nothing to do. What finish() writes does not change (it fuses every keyframe
+  /// again). Real-time mode: false (the worker does this).
   bool preview_step();
-  struct Changes {
-    std::uint64_t epoch = 0, stamp = 0;  // the volume's (TsdfVolume::epoch(), stamp()) when read
-    std::vector<TsdfVolume::BlockKey> blocks;
-  };
-  Changes changes_since(std::uint64_t stamp) const;
-  /// Surface points of each block in `keys` (in order), read while the volume is still in `epoch`; false when it
-  /// is not (the map was fused again from scratch: start over).
-  bool read_surface(const std::vector<TsdfVolume::BlockKey>& keys, std::uint64_t epoch,
-                    std::vector<std::vector<SurfacePoint>>& out) const;
+  /// The volume as last fused, to read from any thread without a lock (it never changes; the next fusion makes a
+  /// new one). Real-time mode: as of the worker's last keyframe.
+  std::shared_ptr<const TsdfVolume> snapshot() const;
   const DenseConfig& config() const { return cfg_; }
   /// The volume, for evaluation: after finish() only.
   const TsdfVolume& volume() const { return volume_; }
@@ -110,34 +105,47 @@ class DenseMapper {
   };
   Stored prepare(DenseKeyframe kf) const;
   DepthView view_of(const Stored& s, const Eigen::Isometry3d& T_wc) const;
-  void fuse_locked(Stored& s, double* ms, bool preview = false);
-  /// Fuses the next keyframe not fused yet, else one whose pose moved; false when there was none.
-  bool fuse_one_locked(bool preview);
+  /// false when `cancel` stopped it part way (the volume is then fit only to be fused again from scratch).
+  bool fuse_locked(Stored& s, bool preview, const std::atomic<bool>* cancel = nullptr);
+  /// Fuses the next keyframe not fused yet, else one whose pose moved; false when there was none (or cancelled).
+  bool fuse_one_locked(bool preview, const std::atomic<bool>* cancel = nullptr);
   void rebuild_locked();
   /// Moves the keyframes add() queued into the store (deterministic mode: prepared already).
   void take_arrived_locked();
+  /// Makes what was fused so far the snapshot readers get.
+  void publish_locked();
   void worker();
+  /// Cancels the worker's fusion and joins it (stop_ set first).
+  void stop_worker();
+  /// Deterministic mode: fuses every keyframe from its current pose if any arrived or moved since.
+  void bring_up_to_date();
   bool moved(const Stored& s, const Eigen::Isometry3d& now) const;
-
   DenseConfig cfg_;
   PinholeCamera camera_;  // scaled to the stored images
   bool threaded_;
-
-  // Lock order: mutex_, then queue_mutex_.
+  // Lock order: fusion_mutex_, queue_mutex_, published_mutex_. Only the fusing thread (real-time mode: the worker,
+  // at idle priority) holds fusion_mutex_ for long; readers take only published_mutex_, for a pointer's copy, so a
+  // reader never waits for a fusion (nor for a worker the scheduler keeps off the CPU).
   mutable std::mutex queue_mutex_;  // what add() touches
   std::condition_variable wake_;
   std::deque<DenseKeyframe> pending_;  // real-time mode: taken, not yet prepared
   std::deque<Stored> arrived_;         // deterministic mode: prepared, not yet in the store
   std::size_t keyframes_ = 0;
   bool stop_ = false, finished_ = false;
-
-  mutable std::mutex mutex_;  // the store and the volume
+  std::atomic<bool> cancel_{false};  // finish() or the destructor: the worker drops the fusion it is in
+  std::mutex fusion_mutex_;  // the store, the working volume and its statistics
   std::deque<Stored> store_;
   std::size_t next_to_fuse_ = 0;
   TsdfVolume volume_;
   DenseStats stats_;
   std::size_t used_pixels_ = 0, moving_pixels_ = 0;
   bool dirty_ = false;
+  struct Published {
+    std::shared_ptr<const TsdfVolume> volume;
+    DenseStats stats;  // without keyframes (the queue's count)
+  };
+  mutable std::mutex published_mutex_;
+  std::shared_ptr<const Published> published_;
   std::thread thread_;
 };
 

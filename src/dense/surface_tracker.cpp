@@ -66,41 +66,29 @@ std::vector<SurfacePoint> SurfaceTracker::thin(TsdfVolume::BlockKey block, const
 }
 
 std::vector<SurfaceTracker::RegionKey> SurfaceTracker::update(const DenseMapper& map) {
+  return update(*map.snapshot());
+}
+
+std::vector<SurfaceTracker::RegionKey> SurfaceTracker::update(const TsdfVolume& volume) {
   std::vector<RegionKey> changed;
-  // The map may be fused again from scratch meanwhile (a new epoch): then start over, a few times at most.
-  for (int attempt = 0; attempt < 3; ++attempt) {
-    DenseMapper::Changes c = map.changes_since(stamp_);
-    if (c.epoch != epoch_) {
-      for (const auto& [k, pts] : blocks_) changed.push_back(region_of(k));
-      blocks_.clear();
-      epoch_ = c.epoch;
-      c = map.changes_since(0);
-      if (c.epoch != epoch_) continue;
-    }
-    bool same_epoch = true;
-    std::vector<std::vector<SurfacePoint>> read;
-    for (std::size_t i = 0; i < c.blocks.size() && same_epoch; i += kBlocksPerRead) {
-      const std::vector<TsdfVolume::BlockKey> chunk(
-          c.blocks.begin() + static_cast<std::ptrdiff_t>(i),
-          c.blocks.begin() + static_cast<std::ptrdiff_t>(std::min(c.blocks.size(), i + kBlocksPerRead)));
-      read.clear();
-      same_epoch = map.read_surface(chunk, epoch_, read);
-      for (std::size_t j = 0; same_epoch && j < chunk.size(); ++j) {
-        std::vector<SurfacePoint> pts = thin(chunk[j], read[j]);
-        const auto it = blocks_.find(chunk[j]);
-        if (pts.empty() && it == blocks_.end()) continue;
-        changed.push_back(region_of(chunk[j]));
-        if (pts.empty()) blocks_.erase(it);
-        else blocks_[chunk[j]] = std::move(pts);
-      }
-    }
-    if (!same_epoch) {
-      epoch_ = ~std::uint64_t{0};
-      continue;
-    }
-    stamp_ = c.stamp;
-    break;
+  if (volume.epoch() != epoch_) {  // fused again from scratch: start over
+    for (const auto& [k, pts] : blocks_) changed.push_back(region_of(k));
+    blocks_.clear();
+    epoch_ = volume.epoch();
+    stamp_ = 0;
   }
+  std::vector<SurfacePoint> read;
+  for (const TsdfVolume::BlockKey k : volume.changed_since(stamp_)) {
+    read.clear();
+    volume.block_surface(k, read);
+    std::vector<SurfacePoint> pts = thin(k, read);
+    const auto it = blocks_.find(k);
+    if (pts.empty() && it == blocks_.end()) continue;
+    changed.push_back(region_of(k));
+    if (pts.empty()) blocks_.erase(it);
+    else blocks_[k] = std::move(pts);
+  }
+  stamp_ = volume.stamp();
   std::sort(changed.begin(), changed.end());
   changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
   return changed;

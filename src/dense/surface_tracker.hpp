@@ -1,7 +1,7 @@
 #pragma once
 // Follows a dense map's surface as it grows, for a live view (the browser viewer's layer, the ROS node's cloud):
-// each update() reads only the blocks the map changed since the previous one, a few blocks per hold of the map's
-// lock, and keeps their surface points (the mesh's vertices) thinned to one point per cube of cell_voxels^3 voxels.
+// each update() reads only the blocks the map changed since the previous one, from a shared copy of the map (no lock
+// held while reading), and keeps their surface points (the mesh's vertices) thinned to one point per cube of cell_voxels^3 voxels.
 // Points are grouped into regions (cubes of kRegionBlocks^3 blocks) so a view resends only the regions that changed.
 // One thread uses a tracker at a time.
 #include <Eigen/Core>
@@ -18,7 +18,6 @@ class DenseMapper;
 class SurfaceTracker {
  public:
   static constexpr int kRegionBlocks = 4;            // a region: 4^3 blocks (64 cm at 2-cm voxels)
-  static constexpr std::size_t kBlocksPerRead = 64;  // blocks read per hold of the map's lock (well under 1 ms)
   using RegionKey = TsdfVolume::BlockKey;
 
   /// cell_voxels: 1, 2, 4 or 8 (std::invalid_argument otherwise).
@@ -27,6 +26,7 @@ class SurfaceTracker {
   /// Reads what changed in `map` since the last call. Returns the regions whose points changed (sorted; a region
   /// may have no points left).
   std::vector<RegionKey> update(const DenseMapper& map);
+  std::vector<RegionKey> update(const TsdfVolume& volume);
 
   std::vector<SurfacePoint> region_points(RegionKey region) const;
   std::vector<SurfacePoint> all_points() const;  // sorted by block: the same map gives the same list

@@ -27,6 +27,23 @@ TsdfVolume::TsdfVolume(const TsdfConfig& cfg) : cfg_(cfg) {
     throw std::invalid_argument("TsdfVolume: voxel size and truncation must be positive, max_range > min_range");
 }
 
+TsdfVolume::TsdfVolume(const TsdfVolume& other, std::uint64_t generation)
+    : cfg_(other.cfg_), blocks_(other.blocks_), stamp_(other.stamp_), epoch_(other.epoch_), generation_(generation) {}
+
+std::shared_ptr<const TsdfVolume> TsdfVolume::share() {
+  std::shared_ptr<const TsdfVolume> copy(new TsdfVolume(*this, generation_));
+  ++generation_;
+  return copy;
+}
+
+TsdfVolume::Block& TsdfVolume::writable(std::shared_ptr<Block>& slot) {
+  if (slot->generation != generation_) {
+    slot = std::make_shared<Block>(*slot);
+    slot->generation = generation_;
+  }
+  return *slot;
+}
+
 TsdfVolume::BlockKey TsdfVolume::key(int bx, int by, int bz) { return pack(bx, by, bz); }
 
 Eigen::Vector3i TsdfVolume::unkey(BlockKey k) {
@@ -39,7 +56,7 @@ const Voxel* TsdfVolume::voxel(const Eigen::Vector3i& ijk) const {
   const int bx = floor_div(ijk.x(), kB), by = floor_div(ijk.y(), kB), bz = floor_div(ijk.z(), kB);
   const auto it = blocks_.find(key(bx, by, bz));
   if (it == blocks_.end()) return nullptr;
-  return &it->second.v[local_index(ijk.x() - bx * kB, ijk.y() - by * kB, ijk.z() - bz * kB)];
+  return &it->second->v[local_index(ijk.x() - bx * kB, ijk.y() - by * kB, ijk.z() - bz * kB)];
 }
 
 const Voxel* TsdfVolume::voxel_at(const Eigen::Vector3d& p) const {
@@ -51,11 +68,11 @@ const Voxel* TsdfVolume::voxel_at(const Eigen::Vector3d& p) const {
 std::size_t TsdfVolume::observed_voxels() const {
   std::size_t n = 0;
   for (const auto& [k, b] : blocks_)
-    for (const Voxel& v : b.v) n += v.weight >= static_cast<float>(cfg_.min_weight) ? 1 : 0;
+    for (const Voxel& v : b->v) n += v.weight >= static_cast<float>(cfg_.min_weight) ? 1 : 0;
   return n;
 }
 
-IntegrationStats TsdfVolume::integrate(const DepthView& view, int sign) {
+IntegrationStats TsdfVolume::integrate(const DepthView& view, int sign, const std::atomic<bool>* cancel) {
   if (view.depth.type() != CV_32FC1 || view.depth.cols != view.camera.width || view.depth.rows != view.camera.height)
     throw std::invalid_argument("TsdfVolume::integrate: depth must be CV_32FC1 of the camera's size");
   const bool have_movers = !view.movers.empty(), have_colour = !view.bgr.empty();
@@ -91,9 +108,13 @@ IntegrationStats TsdfVolume::integrate(const DepthView& view, int sign) {
           const double z = d - trunc + 2 * trunc * s / std::max(n, 1);
           if (z <= 0) continue;
           const Eigen::Vector3d p = o + ray * z;
-          blocks_.try_emplace(key(static_cast<int>(std::floor(p.x() / block_m)),
-                                  static_cast<int>(std::floor(p.y() / block_m)),
-                                  static_cast<int>(std::floor(p.z() / block_m))));
+          const auto [it, made] = blocks_.try_emplace(key(static_cast<int>(std::floor(p.x() / block_m)),
+                                                          static_cast<int>(std::floor(p.y() / block_m)),
+                                                          static_cast<int>(std::floor(p.z() / block_m))));
+          if (made) {
+            it->second = std::make_shared<Block>();
+            it->second->generation = generation_;
+          }
         }
       }
     }
@@ -108,7 +129,11 @@ IntegrationStats TsdfVolume::integrate(const DepthView& view, int sign) {
              cy = static_cast<float>(cam.cy);
   const auto trunc_f = static_cast<float>(trunc), sgn = static_cast<float>(sign);
   const auto keep_free = static_cast<float>(cfg_.carve ? cfg_.keep_free_votes : 0);
-  for (auto& [k, block] : blocks_) {
+  for (auto& [k, slot] : blocks_) {
+    if (cancel && cancel->load(std::memory_order_relaxed)) {
+      st.cancelled = true;
+      return st;
+    }
     const Eigen::Vector3i b = unkey(k);
     const Eigen::Vector3d centre = (b.cast<double>() + Eigen::Vector3d::Constant(0.5)) * block_m;
     const Eigen::Vector3d c = T_cw * centre;
@@ -138,14 +163,14 @@ IntegrationStats TsdfVolume::integrate(const DepthView& view, int sign) {
           const float sdf = d - pc.z();
           if (far && (pc.z() > max_r || sdf <= trunc_f)) continue;
           if (sdf < -trunc_f) continue;
-          Voxel& vox = block.v[local_index(x, y, z)];
-          if (sdf > trunc_f) {
-            if (!cfg_.carve) continue;
+          const bool free_space = sdf > trunc_f;
+          if (free_space ? !cfg_.carve : have_movers && view.movers.at<std::uint8_t>(vi, ui)) continue;
+          Voxel& vox = writable(slot).v[local_index(x, y, z)];
+          if (free_space) {
             vox.sdf_sum += sgn;
             vox.weight += sgn;
             ++st.voxels_carved;
           } else {
-            if (have_movers && view.movers.at<std::uint8_t>(vi, ui)) continue;
             // Space seen empty again and again that now shows a surface: something moved into it (a mover no filter
             // knew). It adds one more free observation instead; a static surface is never seen through like that.
             if (keep_free > 0 && sign > 0 && vox.weight >= keep_free && vox.sdf_sum >= vox.weight - 1e-3f) {
@@ -169,7 +194,7 @@ IntegrationStats TsdfVolume::integrate(const DepthView& view, int sign) {
         }
     if (touched) {
       ++st.blocks_touched;
-      block.stamp = stamp_;
+      slot->stamp = stamp_;
     }
   }
   return st;
@@ -186,7 +211,7 @@ class TsdfVolume::Reader {
     if (k != cached_key_) {
       const auto it = vol_.blocks_.find(k);
       cached_key_ = k;
-      cached_ = it == vol_.blocks_.end() ? nullptr : &it->second;
+      cached_ = it == vol_.blocks_.end() ? nullptr : it->second.get();
     }
     if (!cached_) return nullptr;
     const Voxel* v = &cached_->v[local_index(ijk.x() - bx * kB, ijk.y() - by * kB, ijk.z() - bz * kB)];
@@ -245,7 +270,7 @@ bool TsdfVolume::cell_surface(const std::array<const Voxel*, 8>& c, const Eigen:
 std::vector<TsdfVolume::BlockKey> TsdfVolume::changed_since(std::uint64_t since) const {
   std::vector<BlockKey> out;
   for (const auto& [k, b] : blocks_) {
-    if (b.stamp <= since) continue;
+    if (b->stamp <= since) continue;
     const Eigen::Vector3i c = unkey(k);
     for (int i = 0; i < 8; ++i) {
       const BlockKey n = key(c.x() - (i & 1), c.y() - ((i >> 1) & 1), c.z() - ((i >> 2) & 1));
@@ -266,7 +291,7 @@ void TsdfVolume::block_surface(BlockKey k, std::vector<SurfacePoint>& out) const
   std::array<const Block*, 8> near{};
   for (int i = 0; i < 8; ++i) {
     const auto n = blocks_.find(key(b.x() + (i & 1), b.y() + ((i >> 1) & 1), b.z() + ((i >> 2) & 1)));
-    near[static_cast<std::size_t>(i)] = n == blocks_.end() ? nullptr : &n->second;
+    near[static_cast<std::size_t>(i)] = n == blocks_.end() ? nullptr : n->second.get();
   }
   const auto min_w = static_cast<float>(cfg_.min_weight);
   std::array<const Voxel*, N * N * N> v{};
@@ -306,7 +331,7 @@ Mesh TsdfVolume::extract_mesh() const {
   std::array<const Voxel*, 8> c{};
   for (const BlockKey k : keys) {
     const Eigen::Vector3i b = unkey(k) * kB;
-    const Block& block = blocks_.at(k);
+    const Block& block = *blocks_.at(k);
     for (int z = 0; z < kB; ++z)
       for (int y = 0; y < kB; ++y)
         for (int x = 0; x < kB; ++x) {
@@ -325,7 +350,7 @@ Mesh TsdfVolume::extract_mesh() const {
   // 2. One quad per voxel edge with a sign change, joining the vertices of the four cells around it.
   for (const BlockKey k : keys) {
     const Eigen::Vector3i b = unkey(k) * kB;
-    const Block& block = blocks_.at(k);
+    const Block& block = *blocks_.at(k);
     for (int z = 0; z < kB; ++z)
       for (int y = 0; y < kB; ++y)
         for (int x = 0; x < kB; ++x) {
@@ -370,7 +395,7 @@ std::vector<OccupancyVoxel> TsdfVolume::occupancy() const {
   std::vector<OccupancyVoxel> out;
   for (const BlockKey k : keys) {
     const Eigen::Vector3i b = unkey(k) * kB;
-    const Block& block = blocks_.at(k);
+    const Block& block = *blocks_.at(k);
     for (int z = 0; z < kB; ++z)
       for (int y = 0; y < kB; ++y)
         for (int x = 0; x < kB; ++x) {

@@ -7,10 +7,13 @@
 // was put in (integrate with sign -1): a keyframe whose pose changed after Local BA or a loop is re-integrated.
 //
 // Voxel (i, j, k) has its centre at ((i, j, k) + 0.5) * voxel_size in the world frame (the grid of an OcTree of
-// the same resolution). Not thread-safe: one thread owns a volume.
+// the same resolution). Not thread-safe: one thread owns a volume; share() hands out a copy other threads may read
+// while the owner goes on fusing (blocks are shared until the owner writes one: copy on write).
 #include <Eigen/Geometry>
 #include <array>
+#include <atomic>
 #include <cstdint>
+#include <memory>
 #include <opencv2/core.hpp>
 #include <unordered_map>
 #include <vector>
@@ -71,6 +74,7 @@ struct OccupancyVoxel {
 struct IntegrationStats {
   std::size_t blocks_touched = 0, voxels_updated = 0, voxels_carved = 0, voxels_kept_free = 0, pixels_used = 0,
               pixels_moving = 0;
+  bool cancelled = false;
 };
 
 class TsdfVolume {
@@ -78,13 +82,22 @@ class TsdfVolume {
   static constexpr int kBlock = 8;
   using BlockKey = std::uint64_t;
   explicit TsdfVolume(const TsdfConfig& cfg);
+  // A plain copy would share blocks both sides then write into: share() is the one way to copy.
+  TsdfVolume(const TsdfVolume&) = delete;
+  TsdfVolume& operator=(const TsdfVolume&) = delete;
+  TsdfVolume(TsdfVolume&&) = default;
+  TsdfVolume& operator=(TsdfVolume&&) = default;
 
-  /// Fuses (sign +1) or takes out again (sign -1, the same view and pose) one view.
-  IntegrationStats integrate(const DepthView& view, int sign = 1);
+  /// Fuses (sign +1) or takes out again (sign -1, the same view and pose) one view. When `cancel` becomes true the
+  /// fusion stops part way (IntegrationStats::cancelled): the volume is then half updated, fit only to be cleared.
+  IntegrationStats integrate(const DepthView& view, int sign = 1, const std::atomic<bool>* cancel = nullptr);
   void clear() {
     blocks_.clear();
     ++epoch_;
   }
+  /// A copy as it is now, for readers on other threads: it never changes, whatever this volume fuses afterwards
+  /// (the blocks it holds are copied before this volume writes into them).
+  std::shared_ptr<const TsdfVolume> share();
 
   // Following the surface as it changes (a live view reads only what changed): every integrate() advances the
   // stamp, and each block it changed keeps the stamp of that change. clear() starts a new epoch.
@@ -116,8 +129,12 @@ class TsdfVolume {
   struct Block {
     std::array<Voxel, kBlock * kBlock * kBlock> v;
     std::uint64_t stamp = 0;  // of the last integrate() that changed it
+    std::uint64_t generation = 0;  // the owner's generation_ when made: older ones may be shared with a copy
   };
   class Reader;
+  TsdfVolume(const TsdfVolume& other, std::uint64_t generation);
+  /// The block at `slot`, copied first when a share()d copy may hold it.
+  Block& writable(std::shared_ptr<Block>& slot);
   static BlockKey key(int bx, int by, int bz);
   static Eigen::Vector3i unkey(BlockKey k);
   const Voxel* voxel(const Eigen::Vector3i& ijk) const;
@@ -126,8 +143,9 @@ class TsdfVolume {
   bool cell_surface(const std::array<const Voxel*, 8>& c, const Eigen::Vector3i& o, SurfacePoint& out) const;
 
   TsdfConfig cfg_;
-  std::unordered_map<BlockKey, Block> blocks_;
+  std::unordered_map<BlockKey, std::shared_ptr<Block>> blocks_;
   std::uint64_t stamp_ = 0, epoch_ = 0;
+  std::uint64_t generation_ = 0;  // advanced by share(): blocks made before it are written only after a copy
 };
 
 }  // namespace varslam::dense

@@ -4,6 +4,10 @@
 #include <octomap/OcTree.h>
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <future>
+#include <thread>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -177,6 +181,69 @@ TEST(DenseMapper, TheMapFollowsAKeyframeWhosePoseChanged) {
     EXPECT_EQ(vertices_near_z(m, 2.0f, 0.01f), 0u) << "threaded " << threaded;
     EXPECT_GT(vertices_near_z(m, 2.3f, 0.01f), 1000u) << "threaded " << threaded;
   }
+}
+
+// A shared copy is what the volume was when shared: fusing more (into the same blocks, and new ones) leaves it as
+// it was, and the volume itself goes on as if never shared.
+TEST(Tsdf, ASharedCopyStaysAsItWasWhileTheVolumeFusesOn) {
+  const PinholeCamera c = small_camera();
+  TsdfConfig cfg;
+  TsdfVolume shared_on(cfg), never_shared(cfg);
+  for (TsdfVolume* v : {&shared_on, &never_shared}) v->integrate(view(c, wall_depth(c, 2.0f)));
+  const std::shared_ptr<const TsdfVolume> before = shared_on.share();
+  const Mesh at_share = before->extract_mesh();
+  Eigen::Isometry3d side = Eigen::Isometry3d::Identity();
+  side.translation().x() = 0.5;
+  for (TsdfVolume* v : {&shared_on, &never_shared}) {
+    v->integrate(view(c, wall_depth(c, 1.5f, 1.2f, cv::Rect(40, 30, 60, 50))));  // the same blocks, changed
+    v->integrate(view(c, wall_depth(c, 2.0f), {}, side));                         // and new ones
+  }
+  const Mesh still = before->extract_mesh();
+  ASSERT_EQ(still.vertices.size(), at_share.vertices.size());
+  EXPECT_TRUE(std::equal(still.vertices.begin(), still.vertices.end(), at_share.vertices.begin()));
+  EXPECT_EQ(vertices_near_z(still, 1.5f), 0u);
+  EXPECT_LT(before->block_count(), shared_on.block_count());
+  const Mesh a = shared_on.extract_mesh(), b = never_shared.extract_mesh();
+  ASSERT_EQ(a.vertices.size(), b.vertices.size());
+  EXPECT_TRUE(std::equal(a.vertices.begin(), a.vertices.end(), b.vertices.begin()));
+  EXPECT_GT(vertices_near_z(a, 1.5f), 100u);
+
+  std::atomic<bool> cancel{true};
+  EXPECT_TRUE(shared_on.integrate(view(c, wall_depth(c, 1.0f)), 1, &cancel).cancelled);
+}
+
+// Real-time mode: the worker fuses at idle priority and the scheduler may keep it off a busy CPU in the middle of a
+// keyframe. Readers must not wait for it, and finish() must not wait for the keyframe it was in. Stood in for here
+// by a pose the worker reads while fusing that does not come until released.
+TEST(DenseMapper, ReadersAndFinishDoNotWaitForAStalledFusion) {
+  const PinholeCamera c = small_camera();
+  DenseConfig cfg;
+  cfg.pixel_step = 1;
+  DenseMapper mapper(cfg, c, true);
+  std::promise<void> open;
+  const std::shared_future<void> gate = open.get_future().share();
+  std::atomic<int> asked{0};
+  DenseKeyframe kf;
+  kf.depth = wall_depth(c, 2.0f);
+  kf.pose = [&] {
+    if (asked++ == 0) gate.wait();  // the worker's first fusion stalls here
+    return Eigen::Isometry3d::Identity();
+  };
+  mapper.add(kf);
+  while (asked == 0) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  // The worker is inside its fusion now.
+  EXPECT_TRUE(mapper.mesh().vertices.empty());
+  EXPECT_TRUE(mapper.snapshot()->extract_mesh().vertices.empty());
+  EXPECT_EQ(mapper.stats().keyframes, 1u);
+  EXPECT_EQ(mapper.stats().integrations, 0u);
+  std::thread release([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    open.set_value();
+  });
+  mapper.finish();  // cancels the stalled fusion (once it runs again) and fuses everything from the final poses
+  release.join();
+  EXPECT_GT(vertices_near_z(mapper.mesh(), 2.0f, 0.01f), 1000u);
+  EXPECT_EQ(mapper.stats().rebuilds, 1u);
 }
 
 // A live view's reader: the surface it follows is the mesh's (at cell 1), each update reads only what changed,
