@@ -79,6 +79,7 @@ report::BenchOptions bench_options(BenchCliOptions& o, const CLI::App& cmd) {
   std::vector<std::string> argv{"varslam", "bench", "--matrix", o.matrix, "--scenarios", o.scenarios, "--paths", o.paths,
                                 "--seeds", o.seeds, "--seconds", fmt::format("{}", b.seconds), "--configs", o.configs,
                                 "--detector", b.detector, "--out", b.out.string()};
+  if (b.sensor != "default") argv.insert(argv.end(), {"--sensor", b.sensor});
   if (b.jobs) argv.insert(argv.end(), {"--jobs", std::to_string(b.jobs)});
   for (const auto& r : o.real) argv.insert(argv.end(), {"--real", r});
   for (const auto& s : b.extra_sets) argv.insert(argv.end(), {"--set", s});
@@ -260,6 +261,9 @@ void add_bench_command(CLI::App& app) {
       ->capture_default_str()
       ->check(finite_range(0.0, 3600.0, true));
   cmd->add_option("--configs", o->configs, "Configurations: huber, semantic, kernel, full")->capture_default_str();
+  cmd->add_option("--sensor", o->b.sensor, "Sensor of the synthetic sequences: default | kinect1 (varslam synth --sensor)")
+      ->check(CLI::IsMember({"default", "kinect1"}))
+      ->capture_default_str();
   cmd->add_option("--jobs,-j", o->b.jobs, "Parallel child processes (default: number of cores)");
   cmd->add_option("--out,-o", o->b.out, "Output folder")->capture_default_str()->check(kNonEmptyPath);
   cmd->add_option("--cache", o->b.cache_dir, "Folder of generated sequences, reusable across benchmarks "

@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "cli_common.hpp"
+#include "core/error.hpp"
 #include "commands.hpp"
 #include "synth/synth.hpp"
 
@@ -19,6 +20,8 @@ void add_synth_command(CLI::App& app) {
     bool list = false;
     bool no_preview = false;
     bool hide_movers = false;
+    std::string sensor = "default";
+    std::vector<std::string> sensor_set;
   };
   auto opt = std::make_shared<Options>();
   cmd->add_option("--scenario", opt->cfg.scenario, "static | walking | unknown_box | obstructing_box | balloon | mixed | large_box | large_box_people")
@@ -42,6 +45,15 @@ void add_synth_command(CLI::App& app) {
   cmd->add_option("--box-jitter", opt->cfg.box_jitter_px, "Gaussian jitter of person box edges in pixels")
       ->check(finite_range(0.0, 1000.0))
       ->capture_default_str();
+  cmd->add_option("--sensor", opt->sensor,
+                  "default: per-pixel depth noise, holes, blur, exposure drift | kinect1: also the real-sensor effects "
+                  "measured on the 7-Scenes kitchen (disparity steps, smooth noise, rolling shutter, distortion, "
+                  "colour/depth offset, intrinsics error; docs/synth.md)")
+      ->check(CLI::IsMember({"default", "kinect1"}))
+      ->capture_default_str();
+  cmd->add_option("--sensor-set", opt->sensor_set,
+                  "KEY=VALUE: one real-sensor effect, after --sensor (keys as in scenario.json's sensor.real)")
+      ->take_all();
   cmd->add_flag("--list", opt->list, "Print the scenario names and exit");
   cmd->callback([opt] {
     if (opt->list) {
@@ -52,6 +64,13 @@ void add_synth_command(CLI::App& app) {
     cfg.path_file = opt->path;
     cfg.preview = !opt->no_preview;
     cfg.render_movers = !opt->hide_movers;
+    if (opt->sensor == "kinect1") cfg.real = synth::kinect1_sensor();
+    for (const std::string& kv : opt->sensor_set) {
+      const auto eq = kv.find('=');
+      if (eq == std::string::npos || eq == 0)
+        throw InputError(fmt::format("--sensor-set '{}': expected KEY=VALUE", kv));
+      synth::set_sensor_effect(cfg.real, kv.substr(0, eq), kv.substr(eq + 1));
+    }
     const std::filesystem::path out =
         opt->out.empty() ? std::filesystem::path(fmt::format("synth_{}_{}", cfg.scenario, cfg.seed)) : std::filesystem::path(opt->out);
     cfg.progress = [](std::size_t done, std::size_t total) {

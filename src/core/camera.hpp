@@ -2,6 +2,7 @@
 // Pinhole camera of an RGB-D sensor, with the "virtual stereo" baseline ORB-SLAM uses for depth.
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
+#include <vector>
 
 namespace varslam {
 
@@ -26,5 +27,9 @@ struct PinholeCamera {
     return u >= border && v >= border && u < width - border && v < height - border;
   }
 };
+
+/// The pinhole pixels of distorted pixels `px` (the inverse of the distortion model, iterated until it is exact to
+/// 1e-3 px: OpenCV's default five iterations leave pixels off by up to 2 px at the corners of a Kinect v1's image).
+std::vector<cv::Point2f> undistort_pixels(const PinholeCamera& camera, const std::vector<cv::Point2f>& px);
 
 }  // namespace varslam

@@ -131,7 +131,7 @@ CameraPathChoice resolve_camera_path(const std::string& entry, const fs::path& t
 std::vector<SequenceSpec> synthetic_sequences(const std::vector<std::string>& scenarios,
                                               const std::vector<CameraPathChoice>& paths,
                                               const std::vector<std::uint64_t>& seeds, double seconds,
-                                              const fs::path& cache_dir) {
+                                              const fs::path& cache_dir, const std::string& sensor) {
   std::vector<SequenceSpec> out;
   for (const auto& scenario : scenarios) {
     for (const auto& path : paths) {
@@ -143,8 +143,10 @@ std::vector<SequenceSpec> synthetic_sequences(const std::vector<std::string>& sc
         s.path_start = path.start;
         s.seed = seed;
         s.seconds = seconds;
+        s.sensor = sensor;
         s.id = fmt::format("{}__{}__s{}__{}s", scenario, path.name, seed, seconds);
         s.id += fmt::format("__at{}", path.start);
+        if (sensor != "default") s.id += "__" + sensor;
         s.dir = cache_dir / s.id;
         out.push_back(std::move(s));
       }
@@ -166,9 +168,11 @@ SequenceSpec real_sequence(const fs::path& folder) {
 }
 
 std::vector<std::string> synth_arguments(const SequenceSpec& seq) {
-  return {"synth",       "--scenario", seq.scenario, "--seconds", fmt::format("{}", seq.seconds),
-          "--seed",      std::to_string(seq.seed), "--path", seq.path_file.string(),
-          "--path-start", fmt::format("{}", seq.path_start), "--out", seq.dir.string()};
+  std::vector<std::string> a{"synth",       "--scenario", seq.scenario, "--seconds", fmt::format("{}", seq.seconds),
+                             "--seed",      std::to_string(seq.seed), "--path", seq.path_file.string(),
+                             "--path-start", fmt::format("{}", seq.path_start), "--out", seq.dir.string()};
+  if (seq.sensor != "default") a.insert(a.end(), {"--sensor", seq.sensor});
+  return a;
 }
 
 std::string synth_cache_key(const SequenceSpec& seq) {
@@ -176,6 +180,7 @@ std::string synth_cache_key(const SequenceSpec& seq) {
   k << "scenario=" << seq.scenario << "\npath=" << fs::absolute(seq.path_file).lexically_normal().string()
     << "\npath_start=" << fmt::format("{}", seq.path_start) << "\nseed=" << seq.seed
     << "\nseconds=" << fmt::format("{}", seq.seconds) << "\n";
+  if (seq.sensor != "default") k << "sensor=" << seq.sensor << "\n";  // keeps the default sensor's caches valid
   // Cached sequences of an older generator are regenerated (synth::kGeneratorVersion).
   k << "generator=" << synth::kGeneratorVersion << "\n";
   return k.str();

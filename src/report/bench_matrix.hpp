@@ -68,6 +68,7 @@ struct SequenceSpec {
   double path_start = 0.0;
   std::uint64_t seed = 0;
   double seconds = 0.0;
+  std::string sensor = "default";  // `varslam synth --sensor`: default | kinect1
   bool real = false;
   std::filesystem::path dir;  // where the sequence is (real) or will be generated (synthetic)
 };
@@ -76,7 +77,8 @@ struct SequenceSpec {
 std::vector<SequenceSpec> synthetic_sequences(const std::vector<std::string>& scenarios,
                                               const std::vector<CameraPathChoice>& paths,
                                               const std::vector<std::uint64_t>& seeds, double seconds,
-                                              const std::filesystem::path& cache_dir);
+                                              const std::filesystem::path& cache_dir,
+                                              const std::string& sensor = "default");
 /// A real dataset folder as a sequence (InputError when it is not a folder).
 SequenceSpec real_sequence(const std::filesystem::path& folder);
 

@@ -88,7 +88,7 @@ std::vector<SequenceSpec> plan_sequences(const BenchOptions& o, const fs::path& 
   if (!o.scenarios.empty())
     for (const auto& p : o.paths) paths.push_back(resolve_camera_path(p, o.trajectories_dir, o.seconds));
   std::vector<SequenceSpec> sequences =
-      paths.empty() ? std::vector<SequenceSpec>{} : synthetic_sequences(o.scenarios, paths, o.seeds, o.seconds, cache);
+      paths.empty() ? std::vector<SequenceSpec>{} : synthetic_sequences(o.scenarios, paths, o.seeds, o.seconds, cache, o.sensor);
   for (const auto& r : o.real) sequences.push_back(real_sequence(r));
   if (sequences.empty()) throw InputError("bench: nothing to run (no scenario x path and no --real folder)");
   for (const auto& seq : sequences) {

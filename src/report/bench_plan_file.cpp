@@ -69,6 +69,7 @@ SequenceSpec sequence_from_json(const nlohmann::json& j, const Where& w) {
     s.path_start = key_number(j, "path_start_s", w);
     s.seed = key_count(j, "seed", w);
     s.seconds = key_number(j, "seconds", w);
+    if (j.contains("sensor")) s.sensor = key_string(j, "sensor", w);  // absent: written before sensors had names
   }
   return s;
 }
@@ -240,7 +241,7 @@ nlohmann::json to_json(const SequenceSpec& s) {
                       {"real", s.real}};
   if (!s.real)
     j.update({{"path_file", s.path_file.string()}, {"path_start_s", s.path_start}, {"seed", s.seed},
-              {"seconds", s.seconds}});
+              {"seconds", s.seconds}, {"sensor", s.sensor}});
   return j;
 }
 }  // namespace varslam::report

@@ -75,9 +75,9 @@ std::shared_ptr<FrameFeatures> make_frame_features(std::vector<cv::KeyPoint> key
     }
   }
   if (camera.has_distortion() && n > 0) {
-    std::vector<cv::Point2f> pts(n), und;
+    std::vector<cv::Point2f> pts(n);
     for (std::size_t i = 0; i < n; ++i) pts[i] = keypoints[i].pt;
-    cv::undistortPoints(pts, und, camera.K(), camera.dist_coeffs(), cv::noArray(), camera.K());
+    const std::vector<cv::Point2f> und = undistort_pixels(camera, pts);
     for (std::size_t i = 0; i < n; ++i) keypoints[i].pt = und[i];
   }
   for (std::size_t i = 0; i < n; ++i)

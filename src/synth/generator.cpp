@@ -9,6 +9,7 @@
 #include <cmath>
 #include <fstream>
 #include <mutex>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -247,6 +248,15 @@ SynthSummary generate(const SynthConfig& cfg, const std::filesystem::path& out_d
   dparams.edge_holes = cfg.depth_edge_holes;
   dparams.max_range_m = cfg.depth_max_m;
   dparams.random_holes = cfg.random_holes_per_frame;
+  const RealSensorEffects& real = cfg.real;
+  dparams.noise_blur_px = real.depth_noise_blur_px;
+  dparams.inverse_depth_step = real.inverse_depth_step;
+  dparams.scale = real.depth_scale;
+  dparams.dark_dropout = real.dark_dropout;
+  const std::optional<LensDistortion> lens =
+      real.distorts() ? std::optional<LensDistortion>(std::in_place, cam, real.k1, real.k2, real.k3) : std::nullopt;
+  const Eigen::Isometry3d T_colour_depth(Eigen::Translation3d(real.depth_offset_m));
+  const double dt_depth = real.depth_time_offset_s;
   std::mt19937_64 drift_rng(mix_seed(seed, 55));
   const double ph1 = std::uniform_real_distribution<double>(0, 2 * M_PI)(drift_rng);
   const double ph2 = std::uniform_real_distribution<double>(0, 2 * M_PI)(drift_rng);
@@ -271,7 +281,7 @@ SynthSummary generate(const SynthConfig& cfg, const std::filesystem::path& out_d
   std::mutex failure_mutex;
 
   cv::parallel_for_(cv::Range(0, static_cast<int>(n_frames)), [&](const cv::Range& range) {
-    RenderOutput r;
+    RenderOutput r, rd;
     std::vector<Primitive> dynamic;
     for (int fi = range.start; fi < range.end; ++fi) {
       try {
@@ -281,6 +291,27 @@ SynthSummary generate(const SynthConfig& cfg, const std::filesystem::path& out_d
         dynamic.clear();
         if (cfg.render_movers) movers.primitives_at(t, dynamic);
         renderer.render(scene, dynamic, poses[i], r);
+        if (real.rolling_shutter_s > 0) {
+          const double rows = std::max(1, r.color.rows - 1);
+          apply_rolling_shutter(r.color, r.depth, cam, poses[i], [&](int row) {
+            return pose_at(t + (row / rows - 0.5) * real.rolling_shutter_s);
+          });
+        }
+        // The depth camera: at another instant and from another place when so set, else the colour camera's view.
+        const RenderOutput* depth_view = &r;
+        if (real.renders_depth_apart()) {
+          dynamic.clear();
+          if (cfg.render_movers) movers.primitives_at(t + dt_depth, dynamic);
+          renderer.render(scene, dynamic, pose_at(t + dt_depth) * T_colour_depth, rd);
+          depth_view = &rd;
+        }
+        cv::Mat1f depth_m = depth_view->depth;
+        if (lens) {
+          lens->apply(r.color);
+          lens->apply(r.ids);
+          depth_m = depth_m.clone();
+          lens->apply(depth_m);
+        }
 
         if (cfg.motion_blur && cfg.exposure_s > 0) {
           const cv::Vec2d m =
@@ -290,12 +321,12 @@ SynthSummary generate(const SynthConfig& cfg, const std::filesystem::path& out_d
         const double gain = 1.0 + cfg.exposure_drift * (0.7 * std::sin(2 * M_PI * t / 23.0 + ph1) +
                                                         0.3 * std::sin(2 * M_PI * t / 7.3 + ph2));
         const cv::Mat3b bgr = sense_color(r.color, gain, cfg.image_noise_sigma, rng, gauss);
-        const cv::Mat1w depth = sense_depth(r.depth, dparams, rng, gauss);
+        const cv::Mat1w depth = sense_depth(depth_m, dparams, rng, gauss, lens ? &r.color : &depth_view->color);
         boxes[i] = person_boxes(r.ids, movers.people().size(), stamps[i], cfg, rng, gauss);
 
-        const std::string name = ts_name(stamps[i]) + ".png";
-        write_image_atomically(out_dir / "rgb" / name, bgr, "colour image", png_params);
-        write_image_atomically(out_dir / "depth" / name, depth, "depth image", png_depth_params);
+        write_image_atomically(out_dir / "rgb" / (ts_name(stamps[i]) + ".png"), bgr, "colour image", png_params);
+        write_image_atomically(out_dir / "depth" / (ts_name(stamps[i] + dt_depth) + ".png"), depth, "depth image",
+                               png_depth_params);
         for (std::size_t k = 0; k < preview_idx.size(); ++k)
           if (preview_idx[k] == i) preview[k] = PreviewFrame{bgr.clone(), depth.clone(), boxes[i].boxes, 5000.0};
         const std::size_t now = ++done;
@@ -326,9 +357,9 @@ SynthSummary generate(const SynthConfig& cfg, const std::filesystem::path& out_d
     std::string gt =
         "# ground truth trajectory (camera-to-world, relative to the first pose)\n# timestamp tx ty tz qx qy qz qw\n";
     for (std::size_t i = 0; i < n_frames; ++i) {
-      const std::string ts = ts_name(stamps[i]);
+      const std::string ts = ts_name(stamps[i]), tsd = ts_name(stamps[i] + dt_depth);
       rgb += ts + " rgb/" + ts + ".png\n";
-      dep += ts + " depth/" + ts + ".png\n";
+      dep += tsd + " depth/" + tsd + ".png\n";
       gt += pose_line(stamps[i], poses[i]);
     }
     write_file_atomically(out_dir / "rgb.txt", rgb, "frame list");
@@ -344,7 +375,7 @@ SynthSummary generate(const SynthConfig& cfg, const std::filesystem::path& out_d
   write_boxes_file(by_time, out_dir / "boxes.txt");
 
   Settings settings;
-  settings.camera = cam;
+  settings.camera = stated_camera(cam, real);
   settings.fps = cfg.fps;
   settings.depth_factor = 5000.0;
   save_settings(settings, out_dir / "settings.yaml");
@@ -367,7 +398,8 @@ SynthSummary generate(const SynthConfig& cfg, const std::filesystem::path& out_d
   j["sensor"] = {{"depth_noise", cfg.depth_noise ? "0.0012 + 0.0019 (z - 0.4)^2 m" : "off"},
                  {"depth_edge_holes", cfg.depth_edge_holes}, {"depth_max_m", cfg.depth_max_m},
                  {"random_holes_per_frame", cfg.random_holes_per_frame}, {"image_noise_sigma", cfg.image_noise_sigma},
-                 {"motion_blur", cfg.motion_blur}, {"exposure_s", cfg.exposure_s}, {"exposure_drift", cfg.exposure_drift}};
+                 {"motion_blur", cfg.motion_blur}, {"exposure_s", cfg.exposure_s}, {"exposure_drift", cfg.exposure_drift},
+                 {"real", describe(real)}};
   write_file_atomically(out_dir / "scenario.json", j.dump(2) + "\n", "scenario description");
 
   if (cfg.preview && !preview.empty())

@@ -6,9 +6,35 @@
 
 namespace varslam::synth {
 
-cv::Mat1w sense_depth(const cv::Mat1f& depth_m, const DepthSensorParams& p, SplitMix64& rng, const GaussianTable& gauss) {
+namespace {
+
+// Unit-variance Gaussian noise smoothed over sigma pixels: white noise blurred, rescaled by the blur's gain
+// (a 2-D Gaussian of sigma s keeps 1 / (4 pi s^2) of white noise's variance).
+cv::Mat1f smooth_noise(int rows, int cols, double sigma, SplitMix64& rng, const GaussianTable& gauss) {
+  cv::Mat1f n(rows, cols);
+  for (int v = 0; v < rows; ++v) {
+    float* row = n.ptr<float>(v);
+    for (int u = 0; u < cols; ++u) row[u] = gauss.draw(rng);
+  }
+  cv::GaussianBlur(n, n, cv::Size(0, 0), sigma, sigma, cv::BORDER_REFLECT);
+  n *= static_cast<float>(std::sqrt(4.0 * M_PI) * sigma);
+  return n;
+}
+
+bool dark(const cv::Vec3f& bgr) { return 0.114f * bgr[0] + 0.587f * bgr[1] + 0.299f * bgr[2] < 0.1f; }
+
+}  // namespace
+
+cv::Mat1w sense_depth(const cv::Mat1f& depth_m, const DepthSensorParams& p, SplitMix64& rng, const GaussianTable& gauss,
+                      const cv::Mat3f* color) {
   const int H = depth_m.rows, W = depth_m.cols;
   cv::Mat1w out(H, W);
+  cv::Mat1f field;
+  if (p.noise && p.noise_blur_px > 0) {
+    SplitMix64 field_rng(rng.next());
+    field = smooth_noise(H, W, p.noise_blur_px, field_rng, gauss);
+  }
+  SplitMix64 dark_rng(p.dark_dropout > 0 ? rng.next() : 0);
   for (int v = 0; v < H; ++v) {
     const float* d = depth_m.ptr<float>(v);
     const float* up = depth_m.ptr<float>(std::max(0, v - 1));
@@ -18,9 +44,13 @@ cv::Mat1w sense_depth(const cv::Mat1f& depth_m, const DepthSensorParams& p, Spli
       // Two draws per pixel whatever it shows, so a pixel's noise does not depend on the content elsewhere in the
       // image: scenes that differ only by a mover get identical noise away from the mover.
       const double hole_draw = p.edge_holes ? rng.uniform() : 1.0;
-      const float noise_draw = p.noise ? gauss.draw(rng) : 0.0f;
+      const float noise_draw = p.noise ? (field.empty() ? gauss.draw(rng) : field(v, u)) : 0.0f;
       double z = d[u];
       if (z <= 0 || (p.max_range_m > 0 && z > p.max_range_m)) {
+        o[u] = 0;
+        continue;
+      }
+      if (p.dark_dropout > 0 && color && dark((*color)(v, u)) && dark_rng.uniform() < p.dark_dropout) {
         o[u] = 0;
         continue;
       }
@@ -37,6 +67,9 @@ cv::Mat1w sense_depth(const cv::Mat1f& depth_m, const DepthSensorParams& p, Spli
         }
       }
       if (p.noise) z += kinect_depth_sigma(z) * noise_draw;
+      z *= p.scale;
+      // A structured-light sensor measures disparity: depth comes in steps of 1/z, about step * z^2 apart.
+      if (p.inverse_depth_step > 0 && z > 0) z = 1.0 / (std::max(1.0, std::round(1.0 / (z * p.inverse_depth_step))) * p.inverse_depth_step);
       const double raw = std::round(z * p.depth_factor);
       o[u] = static_cast<std::uint16_t>(std::clamp(raw, 0.0, 65535.0));
     }

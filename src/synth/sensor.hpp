@@ -16,10 +16,17 @@ struct DepthSensorParams {
   double max_range_m = 5.5;  // 0 = unlimited
   int random_holes = 4;
   double depth_factor = 5000.0;
+  // Real-sensor effects (synth/real_sensor.hpp), off at 0 / 1:
+  double noise_blur_px = 0;       // noise smoothed over this many pixels (same standard deviation per pixel)
+  double inverse_depth_step = 0;  // 1/m: reported depth in steps of 1/z
+  double scale = 1.0;             // reported / true depth
+  double dark_dropout = 0;        // chance of no depth where the colour is dark
 };
 
-/// Clean depth (metres) -> 16-bit sensor depth (depth_factor units per metre, 0 = no depth).
-cv::Mat1w sense_depth(const cv::Mat1f& depth_m, const DepthSensorParams& p, SplitMix64& rng, const GaussianTable& gauss);
+/// Clean depth (metres) -> 16-bit sensor depth (depth_factor units per metre, 0 = no depth). `color` (the rendered
+/// colour, for dark_dropout) may be null.
+cv::Mat1w sense_depth(const cv::Mat1f& depth_m, const DepthSensorParams& p, SplitMix64& rng, const GaussianTable& gauss,
+                      const cv::Mat3f* color = nullptr);
 
 /// Blur along the image motion (dx, dy) in pixels during the exposure (no-op below one pixel).
 void motion_blur(cv::Mat3f& img, double dx, double dy);

@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "synth/real_sensor.hpp"
+
 namespace varslam::synth {
 
 /// Changes whenever the same configuration renders different files (written to scenario.json; the bench cache
@@ -37,6 +39,7 @@ struct SynthConfig {
   bool motion_blur = true;          // blur along the image motion caused by the camera during the exposure
   double exposure_s = 0.012;        // exposure time used for motion blur
   double exposure_drift = 0.06;     // amplitude of the slow gain drift (0.06 = +-6 %)
+  RealSensorEffects real;           // what a real camera adds beyond the above (all off; kinect1_sensor(): measured)
   int png_compression = 1;
 
   /// Called after each finished frame (from a worker thread, serialised): frames done, total.

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <opencv2/calib3d.hpp>
+
 #include "core/camera.hpp"
 #include "core/geometry.hpp"
 
@@ -31,6 +33,27 @@ TEST(Camera, ProjectUnprojectRoundTrip) {
   EXPECT_DOUBLE_EQ(p.z(), 2.5);
   EXPECT_FALSE(cam.in_image(-1, 10));
   EXPECT_TRUE(cam.in_image(639.5, 479.5));
+}
+
+// Keypoints of a strongly distorted camera (TUM freiburg1's Kinect v1 colour camera) undistorted: projecting the
+// result with the distortion model gives the pixel back, also at the image's corners.
+TEST(Camera, UndistortedPixelsProjectBackToTheDistortedOnesUpToTheCorners) {
+  PinholeCamera cam;
+  cam.fx = 517.3, cam.fy = 516.5, cam.cx = 318.6, cam.cy = 255.3;
+  cam.k1 = 0.2624, cam.k2 = -0.9531, cam.p1 = -0.0054, cam.p2 = 0.0026, cam.k3 = 1.1633;
+  const std::vector<cv::Point2f> px{{2, 2}, {637, 3}, {5, 476}, {320, 240}, {600, 400}, {40, 30}};
+  const std::vector<cv::Point2f> und = undistort_pixels(cam, px);
+  ASSERT_EQ(und.size(), px.size());
+  std::vector<cv::Point3d> rays;
+  for (const auto& p : und) rays.emplace_back((p.x - cam.cx) / cam.fx, (p.y - cam.cy) / cam.fy, 1.0);
+  std::vector<cv::Point2d> back;
+  cv::projectPoints(rays, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), cam.K(), cam.dist_coeffs(), back);
+  for (std::size_t i = 0; i < px.size(); ++i) {
+    EXPECT_NEAR(back[i].x, px[i].x, 0.01) << px[i];
+    EXPECT_NEAR(back[i].y, px[i].y, 0.01) << px[i];
+  }
+  EXPECT_GT(std::abs(und[0].x - px[0].x), 3.0f);  // the corners do move
+  EXPECT_TRUE(undistort_pixels(cam, {}).empty());
 }
 
 }  // namespace

@@ -130,6 +130,22 @@ TEST(Sequences, MatrixOrderIdsAndCacheKeys) {
   EXPECT_TRUE(contains(args, "--path-start"));
   EXPECT_TRUE(contains(args, "12"));
   EXPECT_TRUE(contains(args, "/p/b.txt"));
+  EXPECT_FALSE(contains(args, "--sensor"));
+  EXPECT_EQ(synth_cache_key(seqs[0]).find("sensor"), std::string::npos);  // caches made before sensors had names
+}
+
+TEST(Sequences, ARealSensorMatrixHasItsOwnSequences) {
+  CameraPathChoice a{"pa", "/p/a.txt", 30, 10};
+  const auto plain = synthetic_sequences({"static"}, {a}, {1}, 5.0, "/cache");
+  const auto kinect = synthetic_sequences({"static"}, {a}, {1}, 5.0, "/cache", "kinect1");
+  ASSERT_EQ(kinect.size(), 1u);
+  EXPECT_NE(kinect[0].id, plain[0].id);
+  EXPECT_NE(kinect[0].dir, plain[0].dir);
+  EXPECT_NE(synth_cache_key(kinect[0]), synth_cache_key(plain[0]));
+  const auto args = synth_arguments(kinect[0]);
+  const auto at = std::find(args.begin(), args.end(), "--sensor");
+  ASSERT_NE(at, args.end());
+  EXPECT_EQ(*(at + 1), "kinect1");
 }
 
 TEST(Sequences, RealFolder) {
