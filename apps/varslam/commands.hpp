@@ -23,5 +23,6 @@ void add_settings_command(CLI::App& app);
 void add_view_command(CLI::App& app);
 void add_bag_command(CLI::App& app);
 void add_dense_bench_command(CLI::App& app);
+void add_sensor_stats_command(CLI::App& app);
 
 }  // namespace varslam::cli

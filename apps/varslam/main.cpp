@@ -30,6 +30,7 @@ int main(int argc, char** argv) {
   varslam::cli::add_view_command(app);
   varslam::cli::add_bag_command(app);
   varslam::cli::add_dense_bench_command(app);
+  varslam::cli::add_sensor_stats_command(app);
   // Runs once the whole command line is parsed, before the subcommand's own callback starts any work.
   app.parse_complete_callback([&app] { varslam::cli::check_flag_needs(app); });
   try {

@@ -29,6 +29,7 @@ struct FrameResult {
   bool new_segment = false;  // tracking was lost and a new map segment started here
   int keypoints = 0, keypoints_with_depth = 0, inliers = 0, depth_edge_rejected = 0;
   slam::FrameTimings timings;
+  slam::PoseResiduals residuals;  // of the inlier matches at the pose tracking solved (empty when not solved)
   // The pose tracking gave the frame, camera-to-world (what a robot uses live); empty when it was not tracked.
   std::optional<Eigen::Isometry3d> T_wc;
   std::size_t map_keyframes = 0, map_points = 0;  // size of the map after this frame
@@ -68,6 +69,8 @@ struct KeyframeEvent {
   std::size_t frame_index = 0;
   double timestamp = 0;
   Eigen::Isometry3d T_wc = Eigen::Isometry3d::Identity();  // as tracking placed it
+  bool new_segment = false;  // the first keyframe of a new map segment (tracking was lost before it)
+  cv::Mat depth;  // the frame's depth (CV_32FC1 metres, in the colour camera); shared, do not write to it
 };
 
 /// Tracking found its place again by global relocalization.

@@ -297,6 +297,7 @@ FrameResult Pipeline::track(const RgbdFrame& input, const std::optional<Detectio
   r.inliers = out.inliers;
   r.depth_edge_rejected = out.depth_edge_rejected;
   r.timings = out.timings;
+  r.residuals = out.residuals;
   r.T_wc = out.live_T_wc;
   r.map_keyframes = system_->map().num_keyframes();
   r.map_points = system_->map().num_map_points();
@@ -316,7 +317,8 @@ FrameResult Pipeline::track(const RgbdFrame& input, const std::optional<Detectio
          &Observer::on_keypoints);
   if (out.relocalized) emit(RelocalizationEvent{r.index, r.timestamp, *out.relocalized}, &Observer::on_relocalization);
   if (out.keyframe && out.live_T_wc)
-    emit(KeyframeEvent{out.keyframe_id, r.index, r.timestamp, *out.live_T_wc}, &Observer::on_keyframe);
+    emit(KeyframeEvent{out.keyframe_id, r.index, r.timestamp, *out.live_T_wc, out.new_segment, frame.depth},
+         &Observer::on_keyframe);
   emit(r, &Observer::on_frame);
   deliver_queued();
   return r;

@@ -50,6 +50,34 @@ void MetricsRecorder::on_frame(const FrameResult& f) {
   keypoints_.push_back(f.keypoints);
   depth_share_.push_back(f.keypoints > 0 ? static_cast<double>(f.keypoints_with_depth) / f.keypoints : 0.0);
   mapping_queue_.push_back(static_cast<double>(f.mapping_queue));
+  const slam::PoseResiduals& r = f.residuals;
+  residual_frames_ += !r.reprojection_px.empty();
+  reprojection_px_.insert(reprojection_px_.end(), r.reprojection_px.begin(), r.reprojection_px.end());
+  for (std::size_t i = 0; i < r.depth_m.size(); ++i) {
+    const double z = r.measured_depth_m[i];
+    depth_residual_m_.push_back(r.depth_m[i]);
+    // Kinect-class depth noise grows with z^2: normalised, near and far observations compare.
+    depth_residual_over_z2_.push_back(r.depth_m[i] / (z * z));
+  }
+}
+
+// Only a subsampled copy is kept; the comparison needs the final poses, so it waits for metrics().
+void MetricsRecorder::on_keyframe(const KeyframeEvent& k) {
+  keyframe_depth_.push_back(keep_keyframe_depth(k.timestamp, k.new_segment, k.depth));
+}
+
+// Residuals pooled over all inliers of all tracked frames (not per-frame medians): frames with many inliers weigh
+// more, as they do in the pose. Track lengths and depth consistency come from the final map and trajectory.
+nlohmann::json MetricsRecorder::sensor(const Pipeline& slam) const {
+  SensorSamples s;
+  s.depth_share = depth_share_;
+  s.reprojection_px = reprojection_px_;
+  s.depth_residual_m = depth_residual_m_;
+  s.depth_residual_over_z2 = depth_residual_over_z2_;
+  s.residual_frames = residual_frames_;
+  s.track_length = track_lengths(slam.map());
+  s.consistency = depth_consistency(keyframe_depth_, slam.camera_trajectory(), slam.settings().camera);
+  return sensor_section(s);
 }
 
 void MetricsRecorder::on_detection(const DetectionEvent& d) {
@@ -138,6 +166,7 @@ nlohmann::json MetricsRecorder::metrics(const Pipeline& slam) const {
   m["loops"] = loops;
   m["keypoints_per_frame"] = count_json(keypoints_);
   m["depth_edge_rejected_per_frame"] = count_json(edge_rejected_);
+  m["sensor"] = sensor(slam);
   if (s.detector != "none" || semantic_ran_) {
     m["semantic"] = {{"detector", s.detector}, {"detector_runs", s.detector_runs},
                      {"asynchronous", s.detector_asynchronous}, {"frames_without_boxes", frames_without_boxes_},

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "pipeline/slam.hpp"
+#include "run/sensor_stats.hpp"
 
 namespace varslam::run {
 
@@ -24,6 +25,7 @@ class MetricsRecorder final : public Observer {
 
   void on_depth_registration(const DepthRegistrationEvent& e) override;
   void on_frame(const FrameResult& f) override;
+  void on_keyframe(const KeyframeEvent& k) override;
   void on_detection(const DetectionEvent& d) override;
   void on_keyframe_mapped(const slam::KeyframeMapped& m) override;
   void on_loop_search(const slam::LoopSearch& s) override { loop_search_ms_.push_back(s.ms); }
@@ -43,6 +45,11 @@ class MetricsRecorder final : public Observer {
   std::vector<double> stamps_, load_ms_, extract_, filter_, match_, pose_, track_, edge_rejected_, keypoints_,
       depth_share_;
   std::size_t tracked_ = 0;
+  // The sensor section (run/sensor_stats.hpp): residuals pooled over the run, keyframe depth for after it.
+  std::vector<double> reprojection_px_, depth_residual_m_, depth_residual_over_z2_;
+  std::size_t residual_frames_ = 0;
+  std::vector<KeyframeDepth> keyframe_depth_;
+  nlohmann::json sensor(const Pipeline& slam) const;
   std::vector<double> keyframe_ms_, ba_ms_, loop_search_ms_;
   nlohmann::json ba_ = nlohmann::json::array();
   int triangulated_ = 0, culled_points_ = 0, culled_keyframes_ = 0;

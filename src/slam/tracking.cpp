@@ -143,6 +143,7 @@ TrackOutcome Tracker::track(const RgbdFrame& input) {
     has_velocity_ = true;
     clean_temporary_matches(cur);
     record_fates(cur, out);
+    out.residuals = inlier_residuals(cur, camera_);
     for (std::size_t i = 0; i < cur.map_points.size(); ++i)
       if (cur.map_points[i] && cur.outlier[i]) cur.map_points[i].reset();
     out.inliers = cur.num_tracked();
@@ -196,6 +197,23 @@ TrackOutcome Tracker::track(const RgbdFrame& input) {
 void Tracker::record_fates(const Frame& cur, TrackOutcome& out) {
   for (std::size_t i = 0; i < cur.map_points.size(); ++i)
     if (cur.map_points[i]) out.keypoint_fate[i] = cur.outlier[i] ? KeypointFate::Outlier : KeypointFate::Inlier;
+}
+
+// Temporary depth points are gone (clean_temporary_matches), so every match left is a map point.
+PoseResiduals Tracker::inlier_residuals(const Frame& cur, const PinholeCamera& camera) {
+  PoseResiduals r;
+  const FrameFeatures& F = *cur.features;
+  for (std::size_t i = 0; i < cur.map_points.size(); ++i) {
+    if (!cur.map_points[i] || cur.outlier[i]) continue;
+    const Eigen::Vector3d p_c = cur.T_cw * cur.map_points[i]->position();
+    if (p_c.z() <= 0) continue;
+    const Eigen::Vector2d uv(F.keypoints[i].pt.x, F.keypoints[i].pt.y);
+    r.reprojection_px.push_back(static_cast<float>((camera.project(p_c) - uv).norm()));
+    if (!F.has_depth(i)) continue;
+    r.depth_m.push_back(static_cast<float>(std::abs(p_c.z() - F.depth[i])));
+    r.measured_depth_m.push_back(F.depth[i]);
+  }
+  return r;
 }
 
 void Tracker::start_in_loaded_map(long next_frame_id, int segments) {

@@ -48,6 +48,14 @@ struct Relocalization {
   int place_score = 0;   // signature matches (of 256)
 };
 
+/// Residuals of a tracked frame's inlier map-point matches at its final pose (after the last pose optimisation):
+/// what the sensor's noise leaves once the pose is solved, a scene-independent statistic (metrics.json "sensor").
+struct PoseResiduals {
+  std::vector<float> reprojection_px;   // |projected - keypoint| in level-0 pixels, one per inlier
+  std::vector<float> depth_m;           // |predicted z - measured z| of the inliers whose keypoint has depth
+  std::vector<float> measured_depth_m;  // the measured z of each depth_m entry (to normalise by z^2)
+};
+
 /// What tracking made of one keypoint of the frame.
 enum class KeypointFate : std::uint8_t { Unmatched = 0, Inlier = 1, Outlier = 2 };
 
@@ -69,6 +77,7 @@ struct TrackOutcome {
   // it: an outlier is a match the kernel gave a weight below its gate (chi-square test of the weighted residual).
   std::shared_ptr<const FrameFeatures> features;
   std::vector<KeypointFate> keypoint_fate;
+  PoseResiduals residuals;  // empty unless the frame was tracked by pose optimisation
   // The keyframe this frame became (keyframe == true), for consumers that follow its pose (the dense map).
   std::shared_ptr<KeyFrame> new_keyframe;
   // Per keypoint of `features`: on the near mover being followed (no point is built on it).
@@ -127,6 +136,7 @@ class Tracker {
   bool initialize(Frame& cur, const Eigen::Isometry3d& T_cw);
   void refresh_last_frame(long frame_id);
   static void record_fates(const Frame& cur, TrackOutcome& out);
+  static PoseResiduals inlier_residuals(const Frame& cur, const PinholeCamera& camera);
   /// Motion model, falling back to (or cross-checked by) the reference keyframe; true when tracked.
   bool track_initial_pose(Frame& cur, FrameTimings& t);
   /// Both return the inliers after pose optimisation (0 when too few matches to optimise).

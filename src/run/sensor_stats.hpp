@@ -1,0 +1,74 @@
+#pragma once
+// Statistics of the sensor that do not depend on the scene (issue #33): residuals after pose optimisation, track
+// lengths of map points, depth consistency between keyframes, share of keypoints with depth. MetricsRecorder
+// writes them into metrics.json ("sensor"); `varslam sensor-stats` puts the sections of several runs side by side,
+// so a synthetic sensor can be compared with a real one.
+#include <Eigen/Geometry>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "core/camera.hpp"
+#include "core/trajectory.hpp"
+
+namespace varslam::slam {
+class Map;
+}
+
+namespace varslam::run {
+
+/// Nearest-rank percentile q in [0, 1] of a sample; 0 when empty.
+double percentile(std::vector<double> v, double q);
+
+/// A keyframe's depth kept for the depth-consistency check after the run: every kDepthStep-th pixel in both
+/// directions, in millimetres (CV_16UC1, 0 = none), so a long run keeps ~150 kB a keyframe instead of 1.2 MB.
+struct KeyframeDepth {
+  static constexpr int kDepthStep = 2;
+  double timestamp = 0;
+  bool new_segment = false;  // first keyframe of a new map segment: not comparable with the keyframe before
+  cv::Mat depth_mm;
+};
+KeyframeDepth keep_keyframe_depth(double timestamp, bool new_segment, const cv::Mat& depth_m);
+
+/// |z_warped - z_b| / z_b for the depth of `a` warped into `b` (camera-to-world poses): every kSampleStep-th
+/// full-resolution pixel of `a` with depth is back-projected, moved into b and compared with b's depth at the
+/// nearest kept pixel (at most one full-resolution pixel away), where b has depth. Lens distortion is ignored,
+/// as the dense map does. Occlusions are counted too (a surface b sees in front of a's point): they land in the
+/// upper tail, which is why the median and p90 are reported rather than a mean.
+inline constexpr int kSampleStep = 4;
+std::vector<double> depth_disagreement(const KeyframeDepth& a, const Eigen::Isometry3d& T_wa, const KeyframeDepth& b,
+                                       const Eigen::Isometry3d& T_wb, const PinholeCamera& cam);
+
+/// depth_disagreement() over every keyframe and the one before it, at their final poses (`final_poses`, looked up
+/// by timestamp); pairs across a new map segment or with a keyframe missing from `final_poses` are skipped.
+struct DepthConsistency {
+  std::vector<double> disagreement;
+  std::size_t pairs = 0;
+};
+DepthConsistency depth_consistency(const std::vector<KeyframeDepth>& keyframes, const Trajectory& final_poses,
+                                   const PinholeCamera& cam);
+
+/// Keyframes observing each map point of the map (points not bad).
+std::vector<double> track_lengths(const slam::Map& map);
+
+/// The sensor section of metrics.json from the pooled samples (see MetricsRecorder::metrics for what each holds).
+struct SensorSamples {
+  std::vector<double> depth_share;                               // per frame
+  std::vector<double> reprojection_px;                           // pooled over the tracked frames' inliers
+  std::vector<double> depth_residual_m, depth_residual_over_z2;  // pooled over the inliers with depth
+  std::size_t residual_frames = 0;                               // frames that gave residuals
+  std::vector<double> track_length;                              // per map point
+  DepthConsistency consistency;
+};
+nlohmann::json sensor_section(const SensorSamples& s);
+
+/// The "sensor" section of RUN_DIR/metrics.json; InputError naming the folder or the file when it is missing,
+/// unreadable or has no such section.
+nlohmann::json read_sensor_section(const std::filesystem::path& run_dir);
+
+/// A markdown table, one row per statistic and one column per run (`names[i]` heads the column of sections[i]).
+std::string sensor_table_markdown(const std::vector<std::string>& names, const std::vector<nlohmann::json>& sections);
+
+}  // namespace varslam::run
