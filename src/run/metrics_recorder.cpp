@@ -52,18 +52,19 @@ void MetricsRecorder::on_frame(const FrameResult& f) {
   mapping_queue_.push_back(static_cast<double>(f.mapping_queue));
   const slam::PoseResiduals& r = f.residuals;
   residual_frames_ += !r.reprojection_px.empty();
-  reprojection_px_.insert(reprojection_px_.end(), r.reprojection_px.begin(), r.reprojection_px.end());
+  for (const double px : r.reprojection_px) reprojection_px_.add(px);
   for (std::size_t i = 0; i < r.depth_m.size(); ++i) {
     const double z = r.measured_depth_m[i];
-    depth_residual_m_.push_back(r.depth_m[i]);
+    depth_residual_m_.add(r.depth_m[i]);
     // Kinect-class depth noise grows with z^2: normalised, near and far observations compare.
-    depth_residual_over_z2_.push_back(r.depth_m[i] / (z * z));
+    depth_residual_over_z2_.add(r.depth_m[i] / (z * z));
   }
 }
 
 // Only a subsampled copy is kept; the comparison needs the final poses, so it waits for metrics().
 void MetricsRecorder::on_keyframe(const KeyframeEvent& k) {
-  keyframe_depth_.push_back(keep_keyframe_depth(k.timestamp, k.new_segment, k.depth));
+  if (keyframe_depth_.size() < kKeyframesWithDepth)
+    keyframe_depth_.push_back(keep_keyframe_depth(k.timestamp, k.new_segment, k.depth));
 }
 
 // Residuals pooled over all inliers of all tracked frames (not per-frame medians): frames with many inliers weigh
@@ -71,10 +72,12 @@ void MetricsRecorder::on_keyframe(const KeyframeEvent& k) {
 nlohmann::json MetricsRecorder::sensor(const Pipeline& slam) const {
   SensorSamples s;
   s.depth_share = depth_share_;
-  s.reprojection_px = reprojection_px_;
-  s.depth_residual_m = depth_residual_m_;
-  s.depth_residual_over_z2 = depth_residual_over_z2_;
+  s.reprojection_px = reprojection_px_.values();
+  s.depth_residual_m = depth_residual_m_.values();
+  s.depth_residual_over_z2 = depth_residual_over_z2_.values();
   s.residual_frames = residual_frames_;
+  s.reprojection_observations = reprojection_px_.seen();
+  s.depth_observations = depth_residual_m_.seen();
   s.track_length = track_lengths(slam.map());
   s.consistency = depth_consistency(keyframe_depth_, slam.camera_trajectory(), slam.settings().camera);
   return sensor_section(s);

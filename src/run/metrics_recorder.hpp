@@ -46,7 +46,8 @@ class MetricsRecorder final : public Observer {
       depth_share_;
   std::size_t tracked_ = 0;
   // The sensor section (run/sensor_stats.hpp): residuals pooled over the run, keyframe depth for after it.
-  std::vector<double> reprojection_px_, depth_residual_m_, depth_residual_over_z2_;
+  SampleReservoir reprojection_px_, depth_residual_m_, depth_residual_over_z2_;
+  static constexpr std::size_t kKeyframesWithDepth = 300;  // about 45 MB; pairs after these are not compared
   std::size_t residual_frames_ = 0;
   std::vector<KeyframeDepth> keyframe_depth_;
   nlohmann::json sensor(const Pipeline& slam) const;

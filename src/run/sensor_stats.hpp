@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 #include <string>
+#include <random>
 #include <vector>
 
 #include "core/camera.hpp"
@@ -54,11 +55,36 @@ DepthConsistency depth_consistency(const std::vector<KeyframeDepth>& keyframes, 
 std::vector<double> track_lengths(const slam::Map& map);
 
 /// The sensor section of metrics.json from the pooled samples (see MetricsRecorder::metrics for what each holds).
+/// A uniform sample of at most `capacity` values of a stream (reservoir sampling, fixed seed: the same stream gives
+/// the same sample), so a run of hours keeps a bounded memory for its residual percentiles.
+class SampleReservoir {
+ public:
+  explicit SampleReservoir(std::size_t capacity = 200000) : capacity_(capacity) {}
+  void add(double v) {
+    ++seen_;
+    if (values_.size() < capacity_) {
+      values_.push_back(v);
+      return;
+    }
+    const std::size_t j = static_cast<std::size_t>(rng_() % seen_);
+    if (j < capacity_) values_[j] = v;
+  }
+  const std::vector<double>& values() const { return values_; }
+  std::size_t seen() const { return seen_; }
+
+ private:
+  std::size_t capacity_, seen_ = 0;
+  std::vector<double> values_;
+  std::mt19937_64 rng_{20261203};
+};
+
 struct SensorSamples {
   std::vector<double> depth_share;                               // per frame
   std::vector<double> reprojection_px;                           // pooled over the tracked frames' inliers
   std::vector<double> depth_residual_m, depth_residual_over_z2;  // pooled over the inliers with depth
   std::size_t residual_frames = 0;                               // frames that gave residuals
+  // Observations behind the residuals (the vectors above may be a uniform sample of them); 0: their sizes.
+  std::size_t reprojection_observations = 0, depth_observations = 0;
   std::vector<double> track_length;                              // per map point
   DepthConsistency consistency;
 };

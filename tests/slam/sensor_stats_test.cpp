@@ -157,3 +157,20 @@ TEST(SensorStats, NoisierDepthGivesLargerDepthResiduals) {
 
 }  // namespace
 }  // namespace varslam::slam
+
+// A long run keeps a bounded sample of its residuals: uniform (its percentiles are the stream's), and the same
+// stream gives the same sample.
+TEST(SensorStats, TheResidualSampleIsBoundedUniformAndRepeatable) {
+  varslam::run::SampleReservoir a(1000), b(1000);
+  for (int i = 0; i < 100000; ++i) {
+    a.add(i % 1000);
+    b.add(i % 1000);
+  }
+  EXPECT_EQ(a.values().size(), 1000u);
+  EXPECT_EQ(a.seen(), 100000u);
+  EXPECT_EQ(a.values(), b.values());
+  std::vector<double> v = a.values();
+  std::sort(v.begin(), v.end());
+  EXPECT_NEAR(v[500], 500.0, 60.0);
+  EXPECT_NEAR(v[950], 950.0, 30.0);
+}
