@@ -17,6 +17,7 @@
 
 #include <fmt/format.h>
 
+#include "cli_runner.hpp"
 #include "slam/e2e_support.hpp"
 
 namespace varslam {
@@ -27,25 +28,11 @@ using ::testing::AllOf;
 using ::testing::HasSubstr;
 using ::testing::Not;
 
-const std::string kCli = std::string(VARSLAM_BINARY_DIR) + "/bin/varslam";
+using cli_test::Outcome;
+using cli_test::kCli;
+using cli_test::slurp;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-struct Outcome {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr
-};
-
-Outcome cli(const std::string& args) {
-  const fs::path log = fs::temp_directory_path() / ("varslam_cli_" + std::to_string(::getpid()) + ".log");
-  const int status = std::system((kCli + " " + args + " > " + log.string() + " 2>&1").c_str());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(log)};
-}
+Outcome cli(const std::string& args) { return cli_test::cli(args, "varslam_cli"); }
 
 const fs::path& base_sequence() {
   static const fs::path dir = [] {

@@ -9,31 +9,18 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "cli_runner.hpp"
+
 namespace varslam {
 namespace {
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
-const std::string kCli = std::string(VARSLAM_BINARY_DIR) + "/bin/varslam";
+using cli_test::Outcome;
+using cli_test::slurp;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-struct Outcome {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr
-};
-
-Outcome cli(const std::string& args) {
-  const fs::path log = fs::temp_directory_path() / ("varslam_sensor_cli_" + std::to_string(::getpid()) + ".log");
-  const int status = std::system((kCli + " " + args + " > " + log.string() + " 2>&1").c_str());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(log)};
-}
+Outcome cli(const std::string& args) { return cli_test::cli(args, "varslam_sensor_cli"); }
 
 // A run folder holding `metrics` as its metrics.json (empty: no metrics.json at all).
 fs::path run_folder(const std::string& name, const std::string& metrics) {
