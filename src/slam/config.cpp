@@ -131,6 +131,7 @@ SlamConfig slam_config_from(const Settings& s) {
   r.candidates = static_cast<std::size_t>(setting<int>(s, "relocalization.candidates"));
   r.min_inliers = setting<int>(s, "relocalization.min_inliers");
   r.loaded_map_min_inliers = setting<int>(s, "relocalization.loaded_map_min_inliers");
+  r.loaded_map_check_inliers = setting<int>(s, "relocalization.loaded_map_check_inliers");
   r.neighbourhood_keyframes = setting<int>(s, "relocalization.neighbourhood_keyframes");
   r.loaded_map_min_score = setting<int>(s, "relocalization.loaded_map_min_score");
   r.loaded_map_candidates = setting<int>(s, "relocalization.loaded_map_candidates");

@@ -119,6 +119,7 @@ struct RelocalizationConfig {
   std::size_t candidates = setting_keys::int_default("relocalization.candidates");  // candidates tried per lost frame
   int min_inliers = setting_keys::int_default("relocalization.min_inliers");        // pose inliers against the candidate keyframe
   int loaded_map_min_inliers = setting_keys::int_default("relocalization.loaded_map_min_inliers");  // first fix in a loaded map
+  int loaded_map_check_inliers = setting_keys::int_default("relocalization.loaded_map_check_inliers");  // its local-map check
   int neighbourhood_keyframes = setting_keys::int_default("relocalization.neighbourhood_keyframes");
   int loaded_map_min_score = setting_keys::int_default("relocalization.loaded_map_min_score");
   int loaded_map_candidates = setting_keys::int_default("relocalization.loaded_map_candidates");

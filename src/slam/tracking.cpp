@@ -26,6 +26,7 @@ double ms_since(Clock::time_point t0) {
 }
 
 constexpr int kMinKeypointsToInitialize = 500;  // enough structure to start a map (ORB-SLAM's rule)
+constexpr int kRecoveryCheckInliers = 50;  // local-map inliers that confirm a recovery in this session's own map
 constexpr int kMinInliersMotion = 10;
 constexpr int kMinEstablished = 30;  // established matches needed to solve on them first
 
@@ -569,13 +570,13 @@ bool Tracker::relocalize(Frame& cur, FrameTimings& t) {
   const RelocalizationConfig& rc = cfg_.relocalization;
   // In a map this session did not build (a loaded map, or localization only) the frame is often between mapped
   // viewpoints, far from any one keyframe: more candidates, fewer inliers asked, and a candidate's covisible
-  // neighbourhood tried as a whole. The local-map check that follows (50 inliers after a recovery) verifies.
-  const bool in_foreign_map = awaiting_loaded_map_ || localization_only_;
+  // neighbourhood tried as a whole. The local-map check that follows verifies.
+  const bool foreign = in_foreign_map();
   const auto candidates = places_->query(places_->signature(*cur.features),
-                                         in_foreign_map ? rc.loaded_map_min_score : rc.min_score,
-                                         in_foreign_map ? rc.loaded_map_candidates : rc.candidates);
+                                         foreign ? rc.loaded_map_min_score : rc.min_score,
+                                         foreign ? rc.loaded_map_candidates : rc.candidates);
   LocalizationConfig lc;
-  lc.min_inliers = in_foreign_map ? rc.loaded_map_min_inliers : rc.min_inliers;
+  lc.min_inliers = foreign ? rc.loaded_map_min_inliers : rc.min_inliers;
   lc.kernel = cfg_.tracking.kernel;
   LocalizationConfig wide = lc;
   wide.ransac_iterations = kNeighbourhoodRansacIterations;
@@ -583,7 +584,7 @@ bool Tracker::relocalize(Frame& cur, FrameTimings& t) {
   for (const auto& cand : candidates) {
     if (tried.contains(cand.keyframe->id())) continue;
     int inliers = locate_against_keyframe(cur, *cand.keyframe, lc);
-    if (inliers == 0 && in_foreign_map) inliers = locate_in_neighbourhood(cur, *cand.keyframe, wide, tried);
+    if (inliers == 0 && foreign) inliers = locate_in_neighbourhood(cur, *cand.keyframe, wide, tried);
     if (inliers == 0) continue;
     t.match_ms += ms_since(t0);
     accept_relocalization(cur, cand.keyframe, inliers, cand.score);
@@ -719,7 +720,8 @@ bool Tracker::track_local_map(Frame& cur, FrameTimings& t) {
     if (mp->num_observations() > 0) ++inliers;
     else ++odometry_inliers;
   }
-  if (recently_recovered) return inliers >= 50;
+  if (recently_recovered)
+    return inliers >= (in_foreign_map() ? cfg_.relocalization.loaded_map_check_inliers : kRecoveryCheckInliers);
   // Localization only: where the map thins out (a view it was not built from), the last frame's depth points carry
   // the pose as visual odometry until the map is in view again.
   if (localization_only_) return inliers + odometry_inliers >= cfg_.tracking.min_inliers_local_map;

@@ -146,6 +146,9 @@ class Tracker {
   /// Global relocalization: place candidates from the database, each located by descriptor matches + RANSAC.
   bool relocalize(Frame& cur, FrameTimings& t);
   bool relocalize_near_hint(Frame& cur);
+  /// A map this session did not build (a loaded map before its first fix, or localization only): the frame is often
+  /// between mapped viewpoints, so relocalization asks less of one keyframe and the local map verifies.
+  bool in_foreign_map() const { return awaiting_loaded_map_ || localization_only_; }
   /// locate_against_points() on `kf` and its best covisibles; adds their ids to `tried` (matched once per frame).
   int locate_in_neighbourhood(Frame& cur, const KeyFrame& kf, const LocalizationConfig& lc,
                               std::unordered_set<long>& tried) const;

@@ -228,6 +228,16 @@ TEST(MapFile, LocalizationOnlyTracksInTheLoadedMapWithoutExtendingIt) {
   EXPECT_NEAR(j["ate"]["rmse"].get<double>(), *s.ate_map_frame_rmse, 1e-9);
 }
 
+// The local-map check of a fix in a loaded map is relocalization.loaded_map_check_inliers: asking more inliers than a
+// frame has keypoints, no fix is confirmed and every frame stays lost.
+TEST(MapFile, AFixInALoadedMapIsConfirmedByItsOwnLocalMapCheck) {
+  const run::RunSummary strict = run_frames(90, 10, "strict_check", saved_map(), true, std::nullopt,
+                                            {"relocalization.loaded_map_check_inliers=100000"});
+  EXPECT_EQ(strict.tracked, 0u);
+  const run::RunSummary usual = run_frames(90, 10, "usual_check", saved_map(), true);
+  EXPECT_GE(usual.tracked, 9u);
+}
+
 TEST(MapFile, MappingOnALoadedMapExtendsItAfterTheLoadedIds) {
   const SavedMap m = load_map_file(saved_map());
   const fs::path extended = temp_path("extended.map");
@@ -290,7 +300,7 @@ namespace varslam::slam {
 namespace {
 
 // A session on a loaded map that starts where one keyframe alone gives fewer than relocalization.min_inliers (30)
-// depth-verified inliers: the first fix asks loaded_map_min_inliers (15), and the local-map check after it verifies.
+// depth-verified inliers: the first fix asks loaded_map_min_inliers (10), and the local-map check after it verifies.
 // Kitchen, map of frames 0-599, session on 700-759: 0 of 60 frames localized with 30, 55 with 15; on 800-859 (see
 // below) 59, where it was 0 before neighbourhoods were matched.
 TEST(MapFile, ASessionOnALoadedMapFindsItsPlaceWhereOneKeyframeSeesLittle) {
