@@ -301,8 +301,8 @@ namespace {
 
 // A session on a loaded map that starts where one keyframe alone gives fewer than relocalization.min_inliers (30)
 // depth-verified inliers: the first fix asks loaded_map_min_inliers (10), and the local-map check after it verifies.
-// Kitchen, map of frames 0-599, session on 700-759: 0 of 60 frames localized with 30, 55 with 15; on 800-859 (see
-// below) 59, where it was 0 before neighbourhoods were matched.
+// Kitchen, map of frames 0-599, session on 700-759: 0 of 60 frames localized with 30, 55 with 15 (measured before the
+// default became 10); on 800-859 (see below) 59, where it was 0 before neighbourhoods were matched.
 TEST(MapFile, ASessionOnALoadedMapFindsItsPlaceWhereOneKeyframeSeesLittle) {
   const fs::path kitchen = kitchen_folder();
   if (!fs::exists(kitchen / "rgb.txt")) GTEST_SKIP() << "no " << kitchen;
