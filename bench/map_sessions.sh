@@ -31,13 +31,17 @@ stamps = [float(l.split()[0]) for l in open(f"{kitchen}/rgb.txt") if l.strip() a
 index = {round(s, 4): i for i, s in enumerate(stamps)}
 m = json.load(open(f"{run}/metrics.json"))
 poses = [float(l.split()[0]) for l in open(f"{run}/CameraTrajectory.txt") if l.strip() and not l.startswith('#')]
-first_fix = min((index.get(round(t, 4), 10**9) for t in poses), default=None)
+# The first fix is the first pose tracking gave live; frames placed back from it afterwards
+# (relocalization.place_back_lost_frames) are in the final trajectory but never were live.
+live = [float(l.split()[0]) for l in open(f"{run}/LiveTrajectory.txt") if l.strip() and not l.startswith('#')]
+first_fix = min((index.get(round(t, 4), 10**9) for t in live), default=None)
 try:
     ate = json.load(open(f"{run}/eval_map.json"))["ate"]["rmse"] * 100
 except Exception:
     ate = float('nan')
 n = m["frames"]
-print(f"{name} start {first}: {m['tracked_frames']}/{n} localized ({100*m['tracked_frames']/n:.1f} %), "
+print(f"{name} start {first}: {m['tracked_frames']}/{n} localized live ({100*m['tracked_frames']/n:.1f} %), "
+      f"{len(poses)}/{n} in the trajectory, "
       f"first fix after {first_fix - first if first_fix is not None else 'none'} frames, ATE in map frame {ate:.2f} cm, "
       f"relocalizations {m['relocalizations']}")
 PY

@@ -111,6 +111,8 @@ class Slam {
   /// Each frame's pose as tracking gave it (a copy).
   std::vector<TimedPose> live_trajectory() const;
   /// Every tracked frame's pose after every correction so far (Local BA, loops). Tracking thread, or after finish().
+  /// In a loaded map, frames lost before the first fix are in it too, placed back from the fix by visual odometry
+  /// (relocalization.place_back_lost_frames); live_trajectory() never has them.
   std::vector<TimedPose> camera_trajectory() const;
   SessionSummary summary() const;
 

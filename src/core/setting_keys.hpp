@@ -189,6 +189,9 @@ inline constexpr KeySpec kKeys[] = {
     detail::integer("relocalization.neighbourhood_keyframes", 10, 0, 1000, "covisible keyframes whose map points join a candidate's when one keyframe alone does not locate the frame in a map this session did not build"),
     detail::integer("relocalization.loaded_map_patience", 90, 1, 1000000,
                     "frames a run started on a loaded map tries to relocalize in it before starting a new segment"),
+    detail::integer("relocalization.check_inliers", 50, 10, 100000, "local-map inliers that confirm a recovery or relocalization in this session's own map"),
+    detail::integer("relocalization.lost_views", 6, 0, 100, "while lost in a map this session did not build, frames chained by visual odometry (one per 1 cm or 1 degree of motion) whose points are matched together when one frame alone does not locate (0: off)"),
+    detail::flag("relocalization.place_back_lost_frames", true, "once a frame is located in a map this session did not build, the frames lost before it get poses in the final trajectory from the fix, along their visual odometry (never live poses)"),
 
     // semantic: the person detector and the depth-aware keypoint filter.
     detail::choice("semantic.detector", "auto", "auto|yolo|boxes|hog|none", "person detector: auto (yolo when its model is found, else none, said once), yolo (OpenCV dnn), boxes (a boxes file), hog, none (no person filter)"),

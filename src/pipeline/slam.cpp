@@ -454,6 +454,7 @@ PipelineSummary Pipeline::summary() const {
     s.map_points = system_->map().num_map_points();
     s.segments = system_->tracker().segments();
     s.relocalizations = system_->tracker().relocalizations();
+    s.placed_back = system_->tracker().placed_back_frames();
     s.near_mover_solves = system_->tracker().near_mover_frames();
   }
   s.detector = masker_ ? masker_->detector_name() : "none";

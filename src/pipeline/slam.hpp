@@ -51,6 +51,7 @@ struct PipelineOptions {
 struct PipelineSummary {
   std::size_t frames = 0, tracked = 0, keyframes = 0, map_points = 0;
   int segments = 0, relocalizations = 0;
+  int placed_back = 0;  // lost frames placed in the final trajectory from a later fix (relocalization.place_back_lost_frames)
   long near_mover_solves = 0;  // pose solves the near-mover check changed (tracking.near_mover_check)
   std::string detector;        // "none" without the person filter
   long detector_runs = 0;

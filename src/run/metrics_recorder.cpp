@@ -132,6 +132,7 @@ nlohmann::json MetricsRecorder::metrics(const Pipeline& slam) const {
   m["tracked_share"] = frames() ? static_cast<double>(tracked_) / static_cast<double>(frames()) : 0.0;
   m["map_segments"] = s.segments;
   m["relocalizations"] = s.relocalizations;
+  m["placed_back_frames"] = s.placed_back;
   m["near_mover_solves"] = s.near_mover_solves;
   m["keyframes"] = s.keyframes;
   m["map_points"] = s.map_points;

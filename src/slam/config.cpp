@@ -136,6 +136,9 @@ SlamConfig slam_config_from(const Settings& s) {
   r.loaded_map_min_score = setting<int>(s, "relocalization.loaded_map_min_score");
   r.loaded_map_candidates = setting<int>(s, "relocalization.loaded_map_candidates");
   r.loaded_map_patience = setting<int>(s, "relocalization.loaded_map_patience");
+  r.check_inliers = setting<int>(s, "relocalization.check_inliers");
+  r.lost_views = setting<int>(s, "relocalization.lost_views");
+  r.place_back_lost_frames = setting<bool>(s, "relocalization.place_back_lost_frames");
   return c;
 }
 

@@ -124,6 +124,9 @@ struct RelocalizationConfig {
   int loaded_map_min_score = setting_keys::int_default("relocalization.loaded_map_min_score");
   int loaded_map_candidates = setting_keys::int_default("relocalization.loaded_map_candidates");
   int loaded_map_patience = setting_keys::int_default("relocalization.loaded_map_patience");
+  int check_inliers = setting_keys::int_default("relocalization.check_inliers");  // own map: a recovery's local-map check
+  int lost_views = setting_keys::int_default("relocalization.lost_views");
+  bool place_back_lost_frames = setting_keys::bool_default("relocalization.place_back_lost_frames");
 };
 
 struct SlamConfig {

@@ -4,6 +4,7 @@
 
 #include "optim/pose_optimizer.hpp"
 #include "optim/rigid_alignment.hpp"
+#include "features/descriptor_matching.hpp"
 #include "slam/ba_problem_builder.hpp"
 #include "slam/matcher.hpp"
 
@@ -106,6 +107,34 @@ int locate_against_points(Frame& cur, const std::vector<MapPointPtr>& points, st
   std::fill(cur.map_points.begin(), cur.map_points.end(), nullptr);
   if (match_points_by_descriptor(cur, points) < cfg.min_matches) return clear_matches(cur);
   return solve_pose_from_matches(cur, seed, cfg);
+}
+
+std::optional<Eigen::Isometry3d> locate_points_by_depth(const CameraPoints& camera,
+                                                        const std::vector<MapPointPtr>& points, std::uint64_t seed,
+                                                        const LocalizationConfig& cfg) {
+  std::vector<MapPointPtr> usable;
+  for (const MapPointPtr& mp : points)
+    if (mp && !mp->is_bad() && !mp->descriptor().empty()) usable.push_back(mp);
+  if (usable.empty() || camera.descriptors.empty()) return std::nullopt;
+  cv::Mat train(static_cast<int>(usable.size()), camera.descriptors.cols, camera.descriptors.type());
+  for (std::size_t r = 0; r < usable.size(); ++r) usable[r]->descriptor().copyTo(train.row(static_cast<int>(r)));
+  std::vector<Eigen::Vector3d> world, cam;
+  std::vector<double> tolerance;
+  // Loose, as for a neighbourhood: the points were seen from elsewhere; the RANSAC rejects the wrong matches.
+  for (const auto& m : match_descriptors(camera.descriptors, train, kDescDistHigh, kNeighbourhoodMatchRatio, true)) {
+    const auto q = static_cast<std::size_t>(m.query);
+    world.push_back(usable[static_cast<std::size_t>(m.train)]->position());
+    cam.push_back(camera.p_c[q]);
+    tolerance.push_back(cfg.tolerance_base + cfg.tolerance_per_m2 * camera.depth[q] * camera.depth[q]);
+  }
+  if (static_cast<int>(world.size()) < cfg.min_inliers) return std::nullopt;
+  optim::RigidRansacConfig rc;
+  rc.iterations = cfg.ransac_iterations;
+  rc.min_inliers = 3;
+  rc.seed = seed;
+  const optim::RigidRansacResult r = optim::estimate_rigid_ransac(world, cam, rc, &tolerance);
+  if (!r.ok || r.inliers < cfg.min_inliers) return std::nullopt;
+  return r.T_ab.inverse();  // T_ab maps camera points to world points
 }
 
 }  // namespace varslam::slam

@@ -2,6 +2,8 @@
 // Locating a frame against one keyframe with no pose prior (relocalization, loop verification): descriptor
 // matches to the keyframe's map points, a rigid 3-D/3-D RANSAC on the keypoints that have depth (RGB-D gives
 // metric points, so three matches fix a pose), then pose-only optimisation on all matches.
+#include <optional>
+
 #include "optim/kernel.hpp"
 #include "slam/frame.hpp"
 #include "slam/keyframe.hpp"
@@ -33,6 +35,20 @@ KeyframeNeighbourhood keyframe_neighbourhood(const KeyFrame& kf, int covisibles)
 /// `seed` makes the RANSAC deterministic.
 int locate_against_points(Frame& cur, const std::vector<MapPointPtr>& points, std::uint64_t seed,
                           const LocalizationConfig& cfg);
+
+/// Metric points in one camera's coordinates (from keypoints with depth, possibly of several frames), each with its
+/// descriptor (one row each) and measured depth.
+struct CameraPoints {
+  std::vector<Eigen::Vector3d> p_c;
+  std::vector<double> depth;
+  cv::Mat descriptors;
+};
+
+/// The camera's pose T_cw from descriptor matches of `camera` to `points` (each map point once) and a rigid RANSAC
+/// on their 3-D positions (cfg.min_inliers, cfg.ransac_iterations, the depth tolerance); empty when none is found.
+std::optional<Eigen::Isometry3d> locate_points_by_depth(const CameraPoints& camera,
+                                                        const std::vector<MapPointPtr>& points, std::uint64_t seed,
+                                                        const LocalizationConfig& cfg);
 
 /// Pose-only optimisation of cur.T_cw on its current matches (outliers dropped from cur.map_points); returns the
 /// inliers. Shared by relocalization and loop verification.

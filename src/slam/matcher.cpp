@@ -21,7 +21,6 @@ constexpr double kFrontalViewCos = 0.998, kFrontalRadius = 2.5, kObliqueRadius =
 constexpr double kSameScaleRatio = 0.8;
 // Nearest-neighbour ratio of the descriptor matching against a keyframe (Lowe's test).
 constexpr double kKeyframeMatchRatio = 0.7;
-constexpr double kNeighbourhoodMatchRatio = 0.9;
 // Fusion gates on the squared reprojection error at the keypoint's scale, 2 and 3 dof, as ORB-SLAM writes them
 // (the 95 % chi-square quantiles 5.991 and 7.815, rounded).
 constexpr double kFuseGateMono = 5.99, kFuseGateStereo = 7.8;

@@ -11,6 +11,7 @@ namespace varslam::slam {
 
 inline constexpr int kDescDistHigh = 100;  // loosest accepted Hamming distance (of 256 bits)
 inline constexpr int kDescDistLow = 50;    // strict distance for fusing and triangulation
+inline constexpr double kNeighbourhoodMatchRatio = 0.9;  // ratio test for points seen from other viewpoints
 
 /// Matches the map points of `last` into `cur` (whose T_cw holds the prediction). `radius` in pixels at level
 /// 0, scaled by the keypoint's level. Returns the number of new matches.

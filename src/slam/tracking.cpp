@@ -26,15 +26,21 @@ double ms_since(Clock::time_point t0) {
 }
 
 constexpr int kMinKeypointsToInitialize = 500;  // enough structure to start a map (ORB-SLAM's rule)
-constexpr int kRecoveryCheckInliers = 50;  // local-map inliers that confirm a recovery in this session's own map
 constexpr int kMinInliersMotion = 10;
 constexpr int kMinEstablished = 30;  // established matches needed to solve on them first
+
+LostFrameChainConfig lost_chain_config(const RelocalizationConfig& rc) {
+  LostFrameChainConfig c;
+  c.max_views = rc.lost_views;
+  return c;
+}
 
 }  // namespace
 
 Tracker::Tracker(const SlamConfig& cfg, const PinholeCamera& camera, double close_depth, Map& map, KeyframeSink& sink)
     : cfg_(cfg), camera_(camera), close_depth_(close_depth), map_(map), sink_(sink),
-      extractor_(make_extractor(cfg.orb, cfg.extractor)), mover_track_(cfg.tracking.mover_track) {
+      extractor_(make_extractor(cfg.orb, cfg.extractor)), mover_track_(cfg.tracking.mover_track),
+      lost_chain_(lost_chain_config(cfg.relocalization)) {
   auto s = std::make_shared<ScaleInfo>();
   s->n_levels = extractor_->n_levels();
   s->scale_factor = extractor_->scale_factor();
@@ -49,6 +55,9 @@ namespace {
 
 // A neighbourhood's loose matches have a low inlier share: 200 RANSAC samples often miss a clean one.
 constexpr int kNeighbourhoodRansacIterations = 1000;
+// Several views' loose matches to the whole neighbourhood of every candidate: a few percent are right, so a clean
+// sample of three is rare (1000 samples found none on the kitchen's reverse start).
+constexpr int kLostViewsRansacIterations = 20000;
 
 // The pixels where keypoints may be taken: those `allowed` (all when empty) that the caller's mover mask leaves.
 cv::Mat without_movers(const cv::Mat& allowed, const cv::Mat& movers) {
@@ -138,6 +147,8 @@ TrackOutcome Tracker::track(const RgbdFrame& input) {
     lost_count_ = 0;
     awaiting_loaded_map_ = false;
     pose_hint_.reset();
+    if (!was_tracked && cfg_.relocalization.place_back_lost_frames) place_back_chained_frames(cur);
+    lost_chain_.clear();
     // After a loss (or before the first fix in a loaded map) the last pose was only predicted: no velocity can be
     // taken from it, and at frame rate standing still is the better guess.
     velocity_ = was_tracked ? cur.T_cw * last_.T_cw.inverse() : Eigen::Isometry3d::Identity();
@@ -189,6 +200,7 @@ TrackOutcome Tracker::track(const RgbdFrame& input) {
                                           mover_track_.config().depth_margin};
   const std::optional<Relocalization> relocalized = std::exchange(relocalized_, std::nullopt);
   if (state_ == TrackState::Ok && !out.new_segment) out.relocalized = relocalized;  // not when local-map tracking failed
+  if (out.relocalized) ++relocalizations_;  // a fix its local-map check refused is not one
   last_ = cur;
   last_is_keyframe_ = out.keyframe;
   out.timings.track_ms = ms_since(t_start);
@@ -559,6 +571,10 @@ bool Tracker::recover(Frame& cur, FrameTimings& t) {
 }
 
 bool Tracker::relocalize(Frame& cur, FrameTimings& t) {
+  const RelocalizationConfig& rc = cfg_.relocalization;
+  // Chained even when this frame is found alone: the frames before it are then placed back from it.
+  const bool chain = in_foreign_map() && (rc.lost_views > 0 || rc.place_back_lost_frames);
+  const LostFrameChain::Added chained = chain ? lost_chain_.add(records_.size(), cur.features) : LostFrameChain::Added{};
   if (pose_hint_) {
     const auto t0 = Clock::now();
     const bool found = relocalize_near_hint(cur);
@@ -567,7 +583,6 @@ bool Tracker::relocalize(Frame& cur, FrameTimings& t) {
   }
   if (!places_ || !cfg_.relocalization.enabled) return false;
   const auto t0 = Clock::now();
-  const RelocalizationConfig& rc = cfg_.relocalization;
   // In a map this session did not build (a loaded map, or localization only) the frame is often between mapped
   // viewpoints, far from any one keyframe: more candidates, fewer inliers asked, and a candidate's covisible
   // neighbourhood tried as a whole. The local-map check that follows verifies.
@@ -592,8 +607,62 @@ bool Tracker::relocalize(Frame& cur, FrameTimings& t) {
                  cand.keyframe->id(), inliers, cand.score);
     return true;
   }
+  LocalizationConfig views_lc = wide;
+  views_lc.ransac_iterations = kLostViewsRansacIterations;
+  const bool found = foreign && chained.new_view && lost_chain_.views() > 1 &&
+                     locate_lost_views(cur, candidates, views_lc);
   t.match_ms += ms_since(t0);
-  return false;
+  return found;
+}
+
+bool Tracker::locate_lost_views(Frame& cur, const std::vector<PlaceCandidate>& candidates,
+                                const LocalizationConfig& lc) {
+  if (candidates.empty()) return false;
+  // The candidates' neighbourhoods as one set of points, each point once.
+  std::vector<MapPointPtr> points;
+  std::unordered_set<long> tried;
+  std::unordered_set<const MapPoint*> seen;
+  for (const auto& cand : candidates) {
+    if (tried.contains(cand.keyframe->id())) continue;
+    const KeyframeNeighbourhood near = keyframe_neighbourhood(*cand.keyframe, cfg_.relocalization.neighbourhood_keyframes);
+    tried.insert(near.keyframe_ids.begin(), near.keyframe_ids.end());
+    for (const auto& mp : near.points)
+      if (seen.insert(mp.get()).second) points.push_back(mp);
+  }
+  const std::optional<Eigen::Isometry3d> T_cw =
+      locate_points_by_depth(lost_chain_.view_points(), points, static_cast<std::uint64_t>(cur.id) + 1, lc);
+  if (!T_cw) return false;
+  // The views agree on a pose for this frame: its own matches at that pose, by projection, decide.
+  const Eigen::Isometry3d prior = cur.T_cw;
+  cur.T_cw = *T_cw;
+  std::fill(cur.map_points.begin(), cur.map_points.end(), nullptr);
+  std::fill(cur.outlier.begin(), cur.outlier.end(), false);
+  match_local_map(cur, points, 2.0, LocalMapUse::Verification);
+  const int inliers = refine_pose_on_matches(cur, lc.kernel);
+  if (inliers < lc.min_inliers) {
+    std::fill(cur.map_points.begin(), cur.map_points.end(), nullptr);
+    cur.T_cw = prior;
+    return false;
+  }
+  accept_relocalization(cur, candidates.front().keyframe, inliers, candidates.front().score);
+  spdlog::info("relocalized at t={:.3f} from {} views chained while lost ({} inliers)", cur.timestamp,
+               lost_chain_.views(), inliers);
+  return true;
+}
+
+void Tracker::place_back_chained_frames(const Frame& cur) {
+  const std::vector<LostFrameChain::Placement> placements = lost_chain_.placements();
+  if (placements.empty() || placements.back().record != records_.size()) return;  // the chain must end at this frame
+  for (const LostFrameChain::Placement& p : placements) {
+    if (p.record >= records_.size() || records_[p.record].tracked) continue;
+    FrameRecord& r = records_[p.record];
+    r.live_T_cw = p.T_c_newest * cur.T_cw;
+    r.reference = cur.reference_kf;
+    r.T_c_ref = r.reference ? r.live_T_cw * r.reference->pose_inverse() : r.live_T_cw;
+    r.tracked = true;
+    r.placed_back = true;
+    ++placed_back_;
+  }
 }
 
 int Tracker::locate_in_neighbourhood(Frame& cur, const KeyFrame& kf, const LocalizationConfig& lc,
@@ -607,7 +676,6 @@ void Tracker::accept_relocalization(Frame& cur, const KeyFramePtr& kf, int inlie
   last_recovery_frame_id_ = cur.id;
   reference_kf_ = kf;
   cur.reference_kf = kf;
-  ++relocalizations_;
   relocalized_ = Relocalization{kf->id(), inliers, score};
 }
 
@@ -720,8 +788,11 @@ bool Tracker::track_local_map(Frame& cur, FrameTimings& t) {
     if (mp->num_observations() > 0) ++inliers;
     else ++odometry_inliers;
   }
-  if (recently_recovered)
-    return inliers >= (in_foreign_map() ? cfg_.relocalization.loaded_map_check_inliers : kRecoveryCheckInliers);
+  // In a map this session did not build the fix is checked on its own frame: the next one, tracked from it, sees as
+  // little of the map (a fix between mapped viewpoints had 40 inliers, its next frame 33-39) and goes on by odometry.
+  const bool checks_fix = in_foreign_map() ? cur.id == last_recovery_frame_id_ : recently_recovered;
+  if (checks_fix)
+    return inliers >= (in_foreign_map() ? cfg_.relocalization.loaded_map_check_inliers : cfg_.relocalization.check_inliers);
   // Localization only: where the map thins out (a view it was not built from), the last frame's depth points carry
   // the pose as visual odometry until the map is in view again.
   if (localization_only_) return inliers + odometry_inliers >= cfg_.tracking.min_inliers_local_map;

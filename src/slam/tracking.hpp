@@ -14,6 +14,7 @@
 #include "slam/keyframe.hpp"
 #include "slam/keyframe_database.hpp"
 #include "slam/keyframe_localization.hpp"
+#include "slam/lost_frame_chain.hpp"
 #include "slam/map.hpp"
 
 namespace varslam::slam {
@@ -97,6 +98,7 @@ struct FrameRecord {
   Eigen::Isometry3d T_c_ref = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d live_T_cw = Eigen::Isometry3d::Identity();  // as tracking gave it: what the final pose is checked by
   bool tracked = false;
+  bool placed_back = false;  // lost when tracked, placed afterwards from a later fix along the lost-frame chain
 };
 
 class Tracker {
@@ -127,6 +129,8 @@ class Tracker {
   const Frame& last_frame() const { return last_; }
   int segments() const { return segments_; }
   int relocalizations() const { return relocalizations_; }
+  /// Frames lost when tracked and placed afterwards from a later fix (FrameRecord::placed_back).
+  int placed_back_frames() const { return placed_back_; }
   /// Pose solves the near-mover check changed (a frame can count more than once: motion model, then local map).
   long near_mover_frames() const { return near_mover_frames_; }
   std::shared_ptr<const ScaleInfo> scale() const { return scale_; }
@@ -153,6 +157,11 @@ class Tracker {
   int locate_in_neighbourhood(Frame& cur, const KeyFrame& kf, const LocalizationConfig& lc,
                               std::unordered_set<long>& tried) const;
   void accept_relocalization(Frame& cur, const KeyFramePtr& kf, int inliers, int score);
+  /// Relocalization of the views chained while lost (slam/lost_frame_chain.hpp), matched together against the
+  /// candidates' neighbourhoods; the frame's own matches at the pose found then decide.
+  bool locate_lost_views(Frame& cur, const std::vector<PlaceCandidate>& candidates, const LocalizationConfig& lc);
+  /// After a fix, the frames chained while lost get their poses back from it (FrameRecord::placed_back).
+  void place_back_chained_frames(const Frame& cur);
   bool track_local_map(Frame& cur, FrameTimings& t);
   int optimize_and_discard(Frame& cur, FrameTimings& t);
   /// The near-mover check (slam/near_mover.hpp) on a solved frame: when the near matches move against the far
@@ -207,8 +216,10 @@ class Tracker {
   bool awaiting_loaded_map_ = false;  // started on a loaded map and not relocalized in it yet
   bool localization_only_ = false;
   int relocalizations_ = 0;
+  int placed_back_ = 0;
   long near_mover_frames_ = 0;
   MoverTrack mover_track_;  // the near mover being followed (slam/mover_track.hpp)
+  LostFrameChain lost_chain_;  // the frames since the loss, in a map this session did not build
   struct PoseHint {
     Eigen::Isometry3d T_wc;
     double radius_m;
