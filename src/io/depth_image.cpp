@@ -39,6 +39,21 @@ double median_valid_depth(const cv::Mat& metres, int step) {
   return *mid;
 }
 
+namespace {
+
+// The pixel std::lround(x) names when it lies in [0, size), else -1. Without the library call: a truncating
+// conversion and the fraction left, which is exact in binary floating point (so half-way cases go away from zero,
+// as std::lround does). The library call took a third of the warp's time.
+int pixel_index(double x, int size) {
+  if (!(x > -0.5 && x < size - 0.5)) return -1;  // NaN fails too
+  int i = static_cast<int>(x);                     // toward zero
+  const double fraction = x - i;
+  if (fraction >= 0.5) ++i;
+  return i;
+}
+
+}  // namespace
+
 cv::Mat register_depth_to_colour(const cv::Mat& depth_m, const DepthCameraRig& rig, const PinholeCamera& colour) {
   CV_Assert(depth_m.type() == CV_32FC1);
   cv::Mat out(colour.height, colour.width, CV_32FC1, cv::Scalar(0.0f));
@@ -52,9 +67,9 @@ cv::Mat register_depth_to_colour(const cv::Mat& depth_m, const DepthCameraRig& r
       const Eigen::Vector3d p = d.unproject(u, v, z) + t;
       if (p.z() <= 0.0) continue;
       const Eigen::Vector2d uv = colour.project(p);
-      const int cu = static_cast<int>(std::lround(uv.x()));
-      const int cv_ = static_cast<int>(std::lround(uv.y()));
-      if (cu < 0 || cv_ < 0 || cu >= out.cols || cv_ >= out.rows) continue;
+      const int cu = pixel_index(uv.x(), out.cols);
+      const int cv_ = pixel_index(uv.y(), out.rows);
+      if (cu < 0 || cv_ < 0) continue;
       float& dst = out.at<float>(cv_, cu);
       const auto zc = static_cast<float>(p.z());
       if (dst == 0.0f || zc < dst) dst = zc;  // z-buffer: the nearer surface occludes the farther one

@@ -1,6 +1,9 @@
 // register_depth_to_colour: a separate depth camera's image moved into the colour camera's pixel grid.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <opencv2/core.hpp>
+
 #include "io/depth_image.hpp"
 
 namespace varslam {
@@ -73,6 +76,40 @@ TEST(RegisterDepth, OutputHasTheColourCameraSize) {
   EXPECT_EQ(r.rows, 60);
   EXPECT_FLOAT_EQ(r.at<float>(30, 40), 1.0f);  // principal points coincide
   EXPECT_FLOAT_EQ(r.at<float>(2, 2), 0.0f);     // outside what the depth camera sees
+}
+
+// The warp as first written (std::lround per pixel), to hold the faster rounding to the same pixels.
+cv::Mat reference_registration(const cv::Mat& depth_m, const DepthCameraRig& rig, const PinholeCamera& colour) {
+  cv::Mat out(colour.height, colour.width, CV_32FC1, cv::Scalar(0.0f));
+  for (int v = 0; v < depth_m.rows; ++v)
+    for (int u = 0; u < depth_m.cols; ++u) {
+      const float z = depth_m.at<float>(v, u);
+      if (!(z > 0.0f)) continue;
+      const Eigen::Vector3d p = rig.depth.unproject(u, v, z) + rig.t_colour_depth;
+      if (p.z() <= 0.0) continue;
+      const Eigen::Vector2d uv = colour.project(p);
+      const long cu = std::lround(uv.x()), cv_ = std::lround(uv.y());
+      if (cu < 0 || cv_ < 0 || cu >= out.cols || cv_ >= out.rows) continue;
+      float& dst = out.at<float>(static_cast<int>(cv_), static_cast<int>(cu));
+      if (dst == 0.0f || static_cast<float>(p.z()) < dst) dst = static_cast<float>(p.z());
+    }
+  return out;
+}
+
+TEST(RegisterDepth, PixelsAreThoseStdLroundNamesIncludingHalfWayAndTheBorders) {
+  cv::RNG rng(3);
+  cv::Mat d(48, 64, CV_32FC1);
+  rng.fill(d, cv::RNG::UNIFORM, 0.3, 4.0);
+  for (int i = 0; i < 200; ++i) d.at<float>(rng.uniform(0, 48), rng.uniform(0, 64)) = 0.0f;
+  // Half a pixel between the cameras' centres: many projections land on (or a hair off) x.5, and the shifts and
+  // translations push pixels across every border.
+  for (const auto& [shift, t] : {std::pair{0.5, Eigen::Vector3d(0, 0, 0)}, std::pair{-0.5, Eigen::Vector3d(0.05, -0.03, 0)},
+                                 std::pair{3.25, Eigen::Vector3d(-0.2, 0.1, 0.02)}}) {
+    DepthCameraRig rig{camera(50, 32, 24), t};
+    const PinholeCamera colour = camera(50, 32 + shift, 24 - shift);
+    const cv::Mat r = register_depth_to_colour(d, rig, colour);
+    EXPECT_EQ(cv::norm(r, reference_registration(d, rig, colour), cv::NORM_INF), 0.0) << "shift " << shift;
+  }
 }
 
 }  // namespace
