@@ -183,7 +183,7 @@ inline constexpr KeySpec kKeys[] = {
     detail::integer("relocalization.candidates", 5, 1, 100, "candidates tried per lost frame"),
     detail::integer("relocalization.min_inliers", 30, 3, 100000, "pose inliers against the candidate keyframe"),
     detail::integer("relocalization.loaded_map_min_inliers", 10, 3, 100000, "the same in a map this session did not build (a loaded map, localization only): a place is rarely seen from one keyframe alone; relocalization.loaded_map_check_inliers verifies the fix"),
-    detail::integer("relocalization.loaded_map_check_inliers", 40, 10, 100000, "local-map inliers that confirm a fix in a map this session did not build (after any other recovery: 50); between mapped viewpoints fewer of the map's points match"),
+    detail::integer("relocalization.loaded_map_check_inliers", 40, 10, 100000, "local-map inliers that confirm a fix in a map this session did not build (after any other recovery: relocalization.check_inliers); between mapped viewpoints fewer of the map's points match"),
     detail::integer("relocalization.loaded_map_min_score", 12, 1, 256, "relocalization.min_score in a map this session did not build (a loaded map, localization only)"),
     detail::integer("relocalization.loaded_map_candidates", 20, 1, 1000, "relocalization.candidates in a map this session did not build; candidates inside a neighbourhood already tried are skipped"),
     detail::integer("relocalization.neighbourhood_keyframes", 10, 0, 1000, "covisible keyframes whose map points join a candidate's when one keyframe alone does not locate the frame in a map this session did not build"),

@@ -78,7 +78,7 @@ LostFrameChain::Added LostFrameChain::add(std::size_t record, std::shared_ptr<co
       clear();
     }
   }
-  if (links_.size() >= cfg_.max_length) {  // drop the oldest frame; views pointing at it go too
+  if (!links_.empty() && links_.size() >= std::max<std::size_t>(cfg_.max_length, 1)) {  // drop the oldest; its view too
     links_.erase(links_.begin());
     std::vector<std::size_t> kept;
     for (const std::size_t v : views_)
@@ -91,7 +91,17 @@ LostFrameChain::Added LostFrameChain::add(std::size_t record, std::shared_ptr<co
     if (views_.size() > static_cast<std::size_t>(cfg_.max_views)) views_.erase(views_.begin());
     added.new_view = true;
   }
+  release_unused_features();
   return added;
+}
+
+void LostFrameChain::release_unused_features() {
+  // Placing back needs only the poses; the features are kept for the views and for the next odometry step.
+  std::vector<bool> needed(links_.size(), false);
+  for (const std::size_t v : views_) needed[v] = true;
+  needed.back() = true;
+  for (std::size_t i = 0; i < links_.size(); ++i)
+    if (!needed[i]) links_[i].features.reset();
 }
 
 void LostFrameChain::clear() {

@@ -51,10 +51,11 @@ class LostFrameChain {
  private:
   struct Link {
     std::size_t record;
-    std::shared_ptr<const FrameFeatures> features;
+    std::shared_ptr<const FrameFeatures> features;  // only while a view or the newest frame
     Eigen::Isometry3d T_anchor_c;  // the frame's pose in the chain's first frame
   };
   bool is_new_view(const Eigen::Isometry3d& T_anchor_c) const;
+  void release_unused_features();
 
   LostFrameChainConfig cfg_;
   std::vector<Link> links_;

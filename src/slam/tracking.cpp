@@ -58,6 +58,9 @@ constexpr int kNeighbourhoodRansacIterations = 1000;
 // Several views' loose matches to the whole neighbourhood of every candidate: a few percent are right, so a clean
 // sample of three is rare (1000 samples found none on the kitchen's reverse start).
 constexpr int kLostViewsRansacIterations = 20000;
+// Map points the views are matched against, at most (whole neighbourhoods, best candidate first): brute-force matching
+// of ~4000 view points costs ~40 ms against 3000 map points and ~200 ms against 20000.
+constexpr std::size_t kLostViewsMaxMapPoints = 4000;
 
 // The pixels where keypoints may be taken: those `allowed` (all when empty) that the caller's mover mask leaves.
 cv::Mat without_movers(const cv::Mat& allowed, const cv::Mat& movers) {
@@ -138,6 +141,7 @@ TrackOutcome Tracker::track(const RgbdFrame& input) {
     ok = track_initial_pose(cur, out.timings);
   } else {
     refresh_last_frame(cur.id);
+    chain_lost_frame(cur, out.timings);
     ok = recover(cur, out.timings);
   }
   if (ok) ok = track_local_map(cur, out.timings);
@@ -176,6 +180,7 @@ TrackOutcome Tracker::track(const RgbdFrame& input) {
         awaiting_loaded_map_ ? cfg_.relocalization.loaded_map_patience : cfg_.tracking.lost_frames_before_reinit;
     if (!localization_only_ && lost_count_ > patience && initialize(cur, cur.T_cw)) {
       awaiting_loaded_map_ = false;
+      lost_chain_.clear();
       spdlog::warn("tracking lost for {} frames at t={:.3f}: new map segment started", lost_count_, cur.timestamp);
       state_ = TrackState::Ok;
       lost_count_ = 0;
@@ -562,6 +567,7 @@ bool Tracker::recover(Frame& cur, FrameTimings& t) {
     // After a loss a pose from few inliers is often a wrong one: ask as much as relocalization does.
     if (track_reference_keyframe(cur, kf, t) >= cfg_.relocalization.min_inliers) {
       last_recovery_frame_id_ = cur.id;
+      fix_in_foreign_map_ = in_foreign_map();
       reference_kf_ = kf;
       spdlog::info("tracking recovered at t={:.3f} against keyframe {}", cur.timestamp, kf->id());
       return true;
@@ -570,11 +576,18 @@ bool Tracker::recover(Frame& cur, FrameTimings& t) {
   return relocalize(cur, t);
 }
 
+void Tracker::chain_lost_frame(const Frame& cur, FrameTimings& t) {
+  chain_step_ = {};
+  const RelocalizationConfig& rc = cfg_.relocalization;
+  if (!in_foreign_map() || (rc.lost_views == 0 && !rc.place_back_lost_frames)) return;
+  // Every lost frame, whichever way it is found: the frames before it are then placed back from it.
+  const auto t0 = Clock::now();
+  chain_step_ = lost_chain_.add(records_.size(), cur.features);
+  t.match_ms += ms_since(t0);
+}
+
 bool Tracker::relocalize(Frame& cur, FrameTimings& t) {
   const RelocalizationConfig& rc = cfg_.relocalization;
-  // Chained even when this frame is found alone: the frames before it are then placed back from it.
-  const bool chain = in_foreign_map() && (rc.lost_views > 0 || rc.place_back_lost_frames);
-  const LostFrameChain::Added chained = chain ? lost_chain_.add(records_.size(), cur.features) : LostFrameChain::Added{};
   if (pose_hint_) {
     const auto t0 = Clock::now();
     const bool found = relocalize_near_hint(cur);
@@ -609,7 +622,7 @@ bool Tracker::relocalize(Frame& cur, FrameTimings& t) {
   }
   LocalizationConfig views_lc = wide;
   views_lc.ransac_iterations = kLostViewsRansacIterations;
-  const bool found = foreign && chained.new_view && lost_chain_.views() > 1 &&
+  const bool found = foreign && chain_step_.new_view && lost_chain_.views() > 1 &&
                      locate_lost_views(cur, candidates, views_lc);
   t.match_ms += ms_since(t0);
   return found;
@@ -623,6 +636,7 @@ bool Tracker::locate_lost_views(Frame& cur, const std::vector<PlaceCandidate>& c
   std::unordered_set<long> tried;
   std::unordered_set<const MapPoint*> seen;
   for (const auto& cand : candidates) {
+    if (points.size() >= kLostViewsMaxMapPoints) break;  // the best candidates' points; the matching is brute force
     if (tried.contains(cand.keyframe->id())) continue;
     const KeyframeNeighbourhood near = keyframe_neighbourhood(*cand.keyframe, cfg_.relocalization.neighbourhood_keyframes);
     tried.insert(near.keyframe_ids.begin(), near.keyframe_ids.end());
@@ -674,6 +688,7 @@ int Tracker::locate_in_neighbourhood(Frame& cur, const KeyFrame& kf, const Local
 
 void Tracker::accept_relocalization(Frame& cur, const KeyFramePtr& kf, int inliers, int score) {
   last_recovery_frame_id_ = cur.id;
+  fix_in_foreign_map_ = in_foreign_map();
   reference_kf_ = kf;
   cur.reference_kf = kf;
   relocalized_ = Relocalization{kf->id(), inliers, score};
@@ -790,9 +805,9 @@ bool Tracker::track_local_map(Frame& cur, FrameTimings& t) {
   }
   // In a map this session did not build the fix is checked on its own frame: the next one, tracked from it, sees as
   // little of the map (a fix between mapped viewpoints had 40 inliers, its next frame 33-39) and goes on by odometry.
-  const bool checks_fix = in_foreign_map() ? cur.id == last_recovery_frame_id_ : recently_recovered;
+  const bool checks_fix = fix_in_foreign_map_ ? cur.id == last_recovery_frame_id_ : recently_recovered;
   if (checks_fix)
-    return inliers >= (in_foreign_map() ? cfg_.relocalization.loaded_map_check_inliers : cfg_.relocalization.check_inliers);
+    return inliers >= (fix_in_foreign_map_ ? cfg_.relocalization.loaded_map_check_inliers : cfg_.relocalization.check_inliers);
   // Localization only: where the map thins out (a view it was not built from), the last frame's depth points carry
   // the pose as visual odometry until the map is in view again.
   if (localization_only_) return inliers + odometry_inliers >= cfg_.tracking.min_inliers_local_map;

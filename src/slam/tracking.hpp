@@ -116,7 +116,10 @@ class Tracker {
   void start_in_loaded_map(long next_frame_id, int segments);
   /// Localization only: track against the map without adding keyframes or points, and never start a new segment
   /// (a lost frame stays lost until relocalization finds it). May be switched at any frame.
-  void set_localization_only(bool on) { localization_only_ = on; }
+  void set_localization_only(bool on) {
+    localization_only_ = on;
+    lost_chain_.clear();  // frames chained before the switch are not placed back after it
+  }
   bool localization_only() const { return localization_only_; }
   /// Where the caller says the camera is (world frame, e.g. from odometry or a click on the map): while not tracking,
   /// relocalization tries the keyframes within `radius_m` of it first and keeps a fix only within `radius_m`. Kept
@@ -149,6 +152,8 @@ class Tracker {
   bool recover(Frame& cur, FrameTimings& t);
   /// Global relocalization: place candidates from the database, each located by descriptor matches + RANSAC.
   bool relocalize(Frame& cur, FrameTimings& t);
+  /// A lost frame in a map this session did not build joins the lost-frame chain (chain_step_ says how).
+  void chain_lost_frame(const Frame& cur, FrameTimings& t);
   bool relocalize_near_hint(Frame& cur);
   /// A map this session did not build (a loaded map before its first fix, or localization only): the frame is often
   /// between mapped viewpoints, so relocalization asks less of one keyframe and the local map verifies.
@@ -220,6 +225,8 @@ class Tracker {
   long near_mover_frames_ = 0;
   MoverTrack mover_track_;  // the near mover being followed (slam/mover_track.hpp)
   LostFrameChain lost_chain_;  // the frames since the loss, in a map this session did not build
+  LostFrameChain::Added chain_step_;  // what adding the frame being tracked did to the chain
+  bool fix_in_foreign_map_ = false;   // the last recovery was in a map this session did not build
   struct PoseHint {
     Eigen::Isometry3d T_wc;
     double radius_m;

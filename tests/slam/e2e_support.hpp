@@ -18,10 +18,15 @@ namespace fs = std::filesystem;
 // Generation is the slow part, so sequences are cached per generator version. ctest runs each test in its own
 // process, possibly in parallel: generate into a private folder, then rename it into place.
 inline fs::path cached_sequence(const std::string& name, synth::SynthConfig cfg) {
-  const fs::path d =
-      fs::temp_directory_path() / ("varslam_e2e_" + name + "_g" + std::to_string(synth::kGeneratorVersion));
+  // Not under ctest's per-run temporary folder: the sequences are kept for later runs and the other builds.
+#ifdef VARSLAM_TEST_CACHE
+  const fs::path cache = VARSLAM_TEST_CACHE;
+#else
+  const fs::path cache = fs::temp_directory_path();
+#endif
+  const fs::path d = cache / ("varslam_e2e_" + name + "_g" + std::to_string(synth::kGeneratorVersion));
   if (fs::exists(d / "groundtruth.txt")) return d;
-  const fs::path tmp = fs::temp_directory_path() / ("varslam_e2e_tmp_" + name + "_" + std::to_string(::getpid()));
+  const fs::path tmp = cache / ("varslam_e2e_tmp_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(tmp);
   cfg.preview = false;
   synth::generate(cfg, tmp);

@@ -7,6 +7,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <map>
+
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -343,6 +345,23 @@ std::size_t poses_in(const fs::path& trajectory) {
   return n;
 }
 
+// Camera poses (camera-to-world) of a TUM trajectory file by timestamp (rounded to 0.1 ms).
+std::map<long, Eigen::Isometry3d> poses_by_time(const fs::path& trajectory) {
+  std::ifstream in(trajectory);
+  std::map<long, Eigen::Isometry3d> out;
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream ss(line);
+    double t = 0, x = 0, y = 0, z = 0, qx = 0, qy = 0, qz = 0, qw = 1;
+    ss >> t >> x >> y >> z >> qx >> qy >> qz >> qw;
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = Eigen::Quaterniond(qw, qx, qy, qz).normalized().toRotationMatrix();
+    T.translation() = Eigen::Vector3d(x, y, z);
+    out[std::lround(t * 1e4)] = T;
+  }
+  return out;
+}
+
 // Kitchen, map of frames 600-999, a session from frame 380: the camera is about a metre from every mapped view, and
 // until frame 422 no frame alone matches 10 map points that agree. Chained by visual odometry while lost, two views
 // 1 cm apart match 13 together (measured: first fix after 1 frame instead of 42), and the frames lost before the fix
@@ -366,6 +385,28 @@ TEST(MapFile, FramesChainedWhileLostAreLocatedTogetherAndPlacedBack) {
   EXPECT_EQ(chained.metrics["placed_back_frames"].get<std::size_t>(), 60u - chained.tracked);
   ASSERT_TRUE(chained.ate_map_frame_rmse);
   EXPECT_LT(*chained.ate_map_frame_rmse, 0.08);  // the placed-back frames included
+
+  // From 400 the first 11 frames are placed back: each where ground truth has it, seen from the fix's camera (the
+  // map's frame and ground truth's differ by a rigid motion, which this leaves out).
+  const run::RunSummary later =
+      e2e::run_with(kitchen, out / "d", session_options(400, 60, out / "k.map", true), {"semantic.detector=none"});
+  const auto placed = poses_by_time(out / "d" / "CameraTrajectory.txt");
+  const auto live = poses_by_time(out / "d" / "LiveTrajectory.txt");
+  const auto truth = poses_by_time(kitchen / "groundtruth.txt");
+  ASSERT_FALSE(live.empty());
+  const long fix = live.begin()->first;
+  ASSERT_TRUE(truth.contains(fix));
+  int checked = 0;
+  for (const auto& [t, T_wc] : placed) {
+    if (t >= fix) break;
+    ASSERT_TRUE(truth.contains(t));
+    const Eigen::Vector3d estimated = placed.at(fix).inverse() * T_wc.translation();
+    const Eigen::Vector3d expected = truth.at(fix).inverse() * truth.at(t).translation();
+    EXPECT_LT((estimated - expected).norm(), 0.02) << "t " << t * 1e-4 << ", " << expected.norm() << " m from the fix";
+    ++checked;
+  }
+  EXPECT_GE(checked, 5);
+  EXPECT_EQ(later.metrics["placed_back_frames"].get<int>(), checked);
 
   const run::RunSummary alone = e2e::run_with(
       kitchen, out / "c", session,
