@@ -57,7 +57,7 @@ int solve_pose_from_matches(Frame& cur, std::uint64_t seed, const LocalizationCo
     world.push_back(mp->position());
     camera.push_back(F.unproject(i));
     const double z = F.depth[i];
-    tolerance.push_back(cfg.tolerance_base + cfg.tolerance_per_m2 * z * z);
+    tolerance.push_back(cfg.tolerance(z));
     idx.push_back(static_cast<int>(i));
   }
   if (static_cast<int>(world.size()) < cfg.min_inliers) return fail();
@@ -112,20 +112,16 @@ int locate_against_points(Frame& cur, const std::vector<MapPointPtr>& points, st
 std::optional<Eigen::Isometry3d> locate_points_by_depth(const CameraPoints& camera,
                                                         const std::vector<MapPointPtr>& points, std::uint64_t seed,
                                                         const LocalizationConfig& cfg) {
-  std::vector<MapPointPtr> usable;
-  for (const MapPointPtr& mp : points)
-    if (mp && !mp->is_bad() && !mp->descriptor().empty()) usable.push_back(mp);
-  if (usable.empty() || camera.descriptors.empty()) return std::nullopt;
-  cv::Mat train(static_cast<int>(usable.size()), camera.descriptors.cols, camera.descriptors.type());
-  for (std::size_t r = 0; r < usable.size(); ++r) usable[r]->descriptor().copyTo(train.row(static_cast<int>(r)));
+  const PointDescriptors usable = point_descriptors(points);
+  if (usable.points.empty() || camera.descriptors.empty()) return std::nullopt;
   std::vector<Eigen::Vector3d> world, cam;
   std::vector<double> tolerance;
   // Loose, as for a neighbourhood: the points were seen from elsewhere; the RANSAC rejects the wrong matches.
-  for (const auto& m : match_descriptors(camera.descriptors, train, kDescDistHigh, kNeighbourhoodMatchRatio, true)) {
+  for (const auto& m : match_descriptors(camera.descriptors, usable.rows, kDescDistHigh, kNeighbourhoodMatchRatio, true)) {
     const auto q = static_cast<std::size_t>(m.query);
-    world.push_back(usable[static_cast<std::size_t>(m.train)]->position());
+    world.push_back(usable.points[static_cast<std::size_t>(m.train)]->position());
     cam.push_back(camera.p_c[q]);
-    tolerance.push_back(cfg.tolerance_base + cfg.tolerance_per_m2 * camera.depth[q] * camera.depth[q]);
+    tolerance.push_back(cfg.tolerance(camera.depth[q]));
   }
   if (static_cast<int>(world.size()) < cfg.min_inliers) return std::nullopt;
   optim::RigidRansacConfig rc;

@@ -16,6 +16,7 @@ struct LocalizationConfig {
   int ransac_iterations = 200;
   // Depth noise grows with the square of depth: a match is a RANSAC inlier within base + per_m2 * z^2 metres.
   double tolerance_base = 0.02, tolerance_per_m2 = 0.01;
+  double tolerance(double z) const { return tolerance_base + tolerance_per_m2 * z * z; }
   optim::KernelConfig kernel;  // pose refinement
 };
 

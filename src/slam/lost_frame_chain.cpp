@@ -13,8 +13,6 @@ namespace {
 
 constexpr double kOdometryMatchRatio = 0.8;  // consecutive frames look alike: a strict ratio test is affordable
 constexpr int kOdometryRansacIterations = 300;
-// Depth noise grows with the square of depth (as in LocalizationConfig): a match is an inlier within this.
-double depth_tolerance(double z) { return 0.02 + 0.01 * z * z; }
 
 struct DepthKeypoints {
   std::vector<int> index;
@@ -45,7 +43,9 @@ std::optional<Eigen::Isometry3d> relative_pose_by_depth(const FrameFeatures& a, 
     const int ia = da.index[static_cast<std::size_t>(m.train)], ib = db.index[static_cast<std::size_t>(m.query)];
     pa.push_back(a.unproject(static_cast<std::size_t>(ia)));
     pb.push_back(b.unproject(static_cast<std::size_t>(ib)));
-    tolerance.push_back(depth_tolerance(std::max(a.depth[static_cast<std::size_t>(ia)], b.depth[static_cast<std::size_t>(ib)])));
+    // The depth-dependent tolerance of relocalization (LocalizationConfig), at the farther of the two depths.
+    tolerance.push_back(LocalizationConfig{}.tolerance(
+        std::max(a.depth[static_cast<std::size_t>(ia)], b.depth[static_cast<std::size_t>(ib)])));
   }
   if (static_cast<int>(pa.size()) < min_inliers) return std::nullopt;
   optim::RigidRansacConfig rc;

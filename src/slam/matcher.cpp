@@ -184,20 +184,25 @@ int match_keyframe_by_descriptor(Frame& cur, const KeyFrame& kf) {
   return n;
 }
 
+PointDescriptors point_descriptors(const std::vector<MapPointPtr>& points) {
+  PointDescriptors d;
+  d.points.reserve(points.size());
+  for (const MapPointPtr& mp : points)
+    if (mp && !mp->is_bad() && !mp->descriptor().empty()) d.points.push_back(mp);
+  d.rows.create(static_cast<int>(d.points.size()), kDescriptorBytes, CV_8U);
+  for (std::size_t r = 0; r < d.points.size(); ++r) d.points[r]->descriptor().copyTo(d.rows.row(static_cast<int>(r)));
+  return d;
+}
+
 int match_points_by_descriptor(Frame& cur, const std::vector<MapPointPtr>& points) {
   const FrameFeatures& F = *cur.features;
-  std::vector<MapPointPtr> usable;
-  usable.reserve(points.size());
-  for (const MapPointPtr& mp : points)
-    if (mp && !mp->is_bad() && !mp->descriptor().empty()) usable.push_back(mp);
-  if (usable.empty() || F.descriptors.empty()) return 0;
-  cv::Mat query(static_cast<int>(usable.size()), F.descriptors.cols, F.descriptors.type());
-  for (std::size_t r = 0; r < usable.size(); ++r) usable[r]->descriptor().copyTo(query.row(static_cast<int>(r)));
+  const PointDescriptors usable = point_descriptors(points);
+  if (usable.points.empty() || F.descriptors.empty()) return 0;
   int n = 0;
   // Loose on purpose: the points were seen from other viewpoints than this frame's, and the rigid RANSAC on depth
   // that follows rejects the wrong matches.
-  for (const auto& m : match_descriptors(query, F.descriptors, kDescDistHigh, kNeighbourhoodMatchRatio, true)) {
-    cur.map_points[m.train] = usable[m.query];
+  for (const auto& m : match_descriptors(usable.rows, F.descriptors, kDescDistHigh, kNeighbourhoodMatchRatio, true)) {
+    cur.map_points[m.train] = usable.points[m.query];
     cur.outlier[m.train] = false;
     ++n;
   }

@@ -31,6 +31,14 @@ int match_local_map(Frame& cur, const std::vector<MapPointPtr>& points, double r
 /// rotation consistency); the fallback when the motion model fails.
 int match_keyframe_by_descriptor(Frame& cur, const KeyFrame& kf);
 
+/// The points of `points` that have a descriptor and are not bad, with their descriptors as the rows of one matrix
+/// (the query or train side of a brute-force descriptor matching).
+struct PointDescriptors {
+  std::vector<MapPointPtr> points;
+  cv::Mat rows;
+};
+PointDescriptors point_descriptors(const std::vector<MapPointPtr>& points);
+
 /// Descriptor matching of map points (their representative descriptors) against all of the frame's keypoints
 /// (ratio test, one point per keypoint), with no pose prior: a place seen from several keyframes at once.
 int match_points_by_descriptor(Frame& cur, const std::vector<MapPointPtr>& points);
