@@ -113,6 +113,7 @@ inline constexpr KeySpec kKeys[] = {
     detail::integer("orb.n_levels", 8, 1, 32, "pyramid levels", "ORBextractor.nLevels"),
     detail::integer("orb.ini_th_fast", 20, 1, 255, "FAST threshold tried first in each grid cell", "ORBextractor.iniThFAST"),
     detail::integer("orb.min_th_fast", 7, 1, 255, "FAST threshold where a cell finds nothing at ini_th_fast (at most ini_th_fast)", "ORBextractor.minThFAST"),
+    detail::integer("orb.threads", 2, 1, 16, "threads extracting one frame's pyramid levels side by side (the caller and orb.threads - 1 helpers); the keypoints are the same for any count"),
     detail::choice("features.extractor", "ours", "ours|opencv", "ORB extractor: our own, or OpenCV's cv::ORB"),
 
     // tracking: frame pose estimation and the keyframe decision.

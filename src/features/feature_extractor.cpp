@@ -21,6 +21,8 @@ FeatureExtractor::FeatureExtractor(const OrbParams& params) : params_(params) {
     bad("ini_th_fast must be in [1, 254], got " + std::to_string(params.ini_th_fast));
   if (params.min_th_fast < 1 || params.min_th_fast > params.ini_th_fast)
     bad("min_th_fast must be in [1, ini_th_fast], got " + std::to_string(params.min_th_fast));
+  if (params.threads < 1 || params.threads > 16)
+    bad("threads must be in [1, 16], got " + std::to_string(params.threads));
 
   for (int l = 0; l < params.n_levels; ++l) {
     const double s = std::pow(params.scale_factor, l);

@@ -16,6 +16,7 @@ struct OrbParams {
   int n_levels = setting_keys::int_default("orb.n_levels");
   int ini_th_fast = setting_keys::int_default("orb.ini_th_fast");  // FAST threshold tried first in every cell
   int min_th_fast = setting_keys::int_default("orb.min_th_fast");  // where the first one finds nothing
+  int threads = setting_keys::int_default("orb.threads");  // our extractor: pyramid levels processed side by side
 };
 
 enum class ExtractorKind { Ours, OpenCV };

@@ -257,6 +257,7 @@ Settings settings_from_yaml(const YAML::Node& root, const std::filesystem::path&
   o.n_levels = setting<int>(s, "orb.n_levels");
   o.ini_th_fast = setting<int>(s, "orb.ini_th_fast");
   o.min_th_fast = setting<int>(s, "orb.min_th_fast");
+  o.threads = setting<int>(s, "orb.threads");
   check_relations(s);
   return s;
 }
@@ -271,8 +272,9 @@ std::string settings_yaml(const Settings& s) {
       c.height, num(s.fps), num(c.bf / c.fx));
   text += fmt::format("depth:\n  factor: {}\n  th_depth: {}\n", num(s.depth_factor), num(s.th_depth));
   text += fmt::format(
-      "orb:\n  n_features: {}\n  scale_factor: {}\n  n_levels: {}\n  ini_th_fast: {}\n  min_th_fast: {}\n",
-      s.orb.n_features, num(s.orb.scale_factor), s.orb.n_levels, s.orb.ini_th_fast, s.orb.min_th_fast);
+      "orb:\n  n_features: {}\n  scale_factor: {}\n  n_levels: {}\n  ini_th_fast: {}\n  min_th_fast: {}\n  threads: {}\n",
+      s.orb.n_features, num(s.orb.scale_factor), s.orb.n_levels, s.orb.ini_th_fast, s.orb.min_th_fast,
+      s.orb.threads);
 
   // Keep the stage sections; drop the ones written above, ORB-SLAM's flat dotted keys and its undotted spellings of
   // ours (DepthMapFactor, ThDepth): written above in our spelling, they would be a second spelling of the key.

@@ -17,6 +17,7 @@ struct OrbSettings {
   int n_levels = setting_keys::int_default("orb.n_levels");
   int ini_th_fast = setting_keys::int_default("orb.ini_th_fast");
   int min_th_fast = setting_keys::int_default("orb.min_th_fast");
+  int threads = setting_keys::int_default("orb.threads");
 };
 
 struct Settings {

@@ -29,6 +29,24 @@ struct NormalEquations {
   Matrix6d H(bool newton) const { return newton ? Matrix6d(H_irls + H_radial) : H_irls; }
 };
 
+/// Adds one observation's terms to the normal equations, with its Jacobian at fixed size: Dof rows of
+/// de/dp_c [-[p_c]x | I], the pose Jacobian of the left update.
+template <int Dof>
+void accumulate(const Eigen::Matrix3d& de_dpc, const Eigen::Vector3d& p_c, const double* e, double sq,
+                const double rho[3], NormalEquations& ne) {
+  Eigen::Matrix<double, Dof, 6> J;
+  J.template leftCols<3>().noalias() = de_dpc.topRows<Dof>() * (-skew(p_c));
+  J.template rightCols<3>() = de_dpc.topRows<Dof>();
+  const Eigen::Map<const Eigen::Matrix<double, Dof, 1>> ev(e);
+  const Vector6d Jte = J.transpose() * ev;
+  ne.H_irls.noalias() += rho[1] * J.transpose() * J;
+  if (rho[2] != 0.0 && sq > 0.0) {
+    const double radial = std::max(rho[1] + 2.0 * sq * rho[2], 0.0);
+    ne.H_radial.noalias() += ((radial - rho[1]) / sq) * Jte * Jte.transpose();
+  }
+  ne.b.noalias() += rho[1] * Jte;
+}
+
 /// Robust cost (and optionally the normal equations) of the active observations at T.
 double linearize(const PinholeCamera& cam, const Eigen::Isometry3d& T, const std::vector<Eigen::Vector3d>& points,
                  const std::vector<Observation>& obs, const std::vector<bool>& active, const Kernel& kernel,
@@ -40,24 +58,19 @@ double linearize(const PinholeCamera& cam, const Eigen::Isometry3d& T, const std
     ne->b.setZero();
   }
   double e[3], rho[3];
-  Eigen::Matrix3d J_pc;
+  Eigen::Matrix3d de_dpc;
   for (std::size_t i = 0; i < obs.size(); ++i) {
     if (!active[i]) continue;
     const Eigen::Vector3d p_c = T * points[i];
-    const int dof = whitened_residual(cam, obs[i], p_c, e, ne ? &J_pc : nullptr);
-    const Eigen::Map<const Eigen::VectorXd> ev(e, dof);
-    const double sq = ev.squaredNorm();
+    const int dof = whitened_residual(cam, obs[i], p_c, e, ne ? &de_dpc : nullptr);
+    const double sq = dof == 3 ? e[0] * e[0] + e[1] * e[1] + e[2] * e[2] : e[0] * e[0] + e[1] * e[1];
     kernel.evaluate(dof, sq, rho);
     cost += rho[0];
     if (!ne) continue;
-    const Eigen::Matrix<double, Eigen::Dynamic, 6, 0, 3, 6> J = J_pc.topRows(dof) * dpc_dpose(p_c);
-    const Vector6d Jte = J.transpose() * ev;
-    ne->H_irls.noalias() += rho[1] * J.transpose() * J;
-    if (rho[2] != 0.0 && sq > 0.0) {
-      const double radial = std::max(rho[1] + 2.0 * sq * rho[2], 0.0);
-      ne->H_radial.noalias() += ((radial - rho[1]) / sq) * Jte * Jte.transpose();
-    }
-    ne->b.noalias() += rho[1] * Jte;
+    if (dof == 3)
+      accumulate<3>(de_dpc, p_c, e, sq, rho, *ne);
+    else
+      accumulate<2>(de_dpc, p_c, e, sq, rho, *ne);
   }
   return 0.5 * cost;
 }

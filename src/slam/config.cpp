@@ -69,6 +69,7 @@ SlamConfig slam_config_from(const Settings& s) {
   c.orb.n_levels = s.orb.n_levels;
   c.orb.ini_th_fast = s.orb.ini_th_fast;
   c.orb.min_th_fast = s.orb.min_th_fast;
+  c.orb.threads = s.orb.threads;
   c.extractor = setting<std::string>(s, "features.extractor") == "ours" ? ExtractorKind::Ours : ExtractorKind::OpenCV;
 
   TrackingConfig& t = c.tracking;

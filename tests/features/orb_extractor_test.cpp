@@ -67,6 +67,9 @@ TEST(OrbExtractor, RejectsBadParameters) {
   p = OrbParams{};
   p.min_th_fast = 30;
   EXPECT_THROW(make_extractor(p), InputError);
+  p = OrbParams{};
+  p.threads = 0;
+  EXPECT_THROW(make_extractor(p), InputError);
 }
 
 TEST(OrbExtractor, ReturnsAboutTheBudgetInsideTheImage) {
@@ -181,6 +184,43 @@ TEST(OrbExtractor, IsDeterministic) {
       EXPECT_EQ(other->keypoints[i].octave, e1.keypoints[i].octave);
     }
     EXPECT_EQ(cv::norm(other->descriptors, e1.descriptors, cv::NORM_HAMMING), 0.0);
+  }
+}
+
+TEST(OrbExtractor, ThreadCountDoesNotChangeTheKeypoints) {
+  // Levels run side by side; the budgets pass from level to level, so a level's share must not depend on
+  // which level finished first. A mask and a small budget make the carry between levels matter.
+  const cv::Mat img = textured_image(640, 480, 5);
+  cv::Mat1b mask(img.size(), uchar(255));
+  mask(cv::Rect(100, 0, 300, 480)).setTo(0);
+  for (const int n_features : {1000, 150}) {
+    for (const bool masked : {false, true}) {
+      SCOPED_TRACE(std::to_string(n_features) + (masked ? " masked" : ""));
+      OrbParams one;
+      one.n_features = n_features;
+      one.threads = 1;
+      auto reference = make_extractor(one);
+      Extracted ref;
+      reference->extract(img, ref.keypoints, ref.descriptors, masked ? cv::Mat(mask) : cv::Mat());
+      ASSERT_GT(ref.keypoints.size(), 0.8 * n_features);
+      for (const int threads : {2, 3, 8}) {
+        OrbParams p = one;
+        p.threads = threads;
+        auto ex = make_extractor(p);
+        for (int repeat = 0; repeat < 3; ++repeat) {
+          Extracted e;
+          ex->extract(img, e.keypoints, e.descriptors, masked ? cv::Mat(mask) : cv::Mat());
+          ASSERT_EQ(e.keypoints.size(), ref.keypoints.size()) << threads << " threads";
+          for (std::size_t i = 0; i < e.keypoints.size(); ++i) {
+            ASSERT_EQ(e.keypoints[i].pt, ref.keypoints[i].pt) << i;
+            ASSERT_EQ(e.keypoints[i].angle, ref.keypoints[i].angle) << i;
+            ASSERT_EQ(e.keypoints[i].octave, ref.keypoints[i].octave) << i;
+            ASSERT_EQ(e.keypoints[i].response, ref.keypoints[i].response) << i;
+          }
+          ASSERT_EQ(cv::norm(e.descriptors, ref.descriptors, cv::NORM_HAMMING), 0.0);
+        }
+      }
+    }
   }
 }
 
