@@ -16,6 +16,7 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include "core/elapsed.hpp"
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
 #include "io/settings_registry.hpp"
@@ -45,10 +46,6 @@ DenseConfig dense_config(const Settings& s) {
 }
 
 namespace {
-
-double ms_since(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
-}
 
 PinholeCamera scaled(const PinholeCamera& c, int step) {
   PinholeCamera s = c;

@@ -8,11 +8,6 @@
 #include "dense/dense_mapper.hpp"
 
 namespace varslam::dense {
-namespace {
-
-int floor_div(int a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
-
-}  // namespace
 
 SurfaceTracker::SurfaceTracker(int cell_voxels, double voxel_size) : cell_(cell_voxels), voxel_size_(voxel_size) {
   if (cell_voxels != 1 && cell_voxels != 2 && cell_voxels != 4 && cell_voxels != 8)

@@ -11,8 +11,6 @@ namespace {
 constexpr int kB = TsdfVolume::kBlock;
 constexpr int kBias = 1 << 20;  // block coordinates are stored biased by this in 21 bits each
 
-int floor_div(int a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
-
 std::uint64_t pack(int x, int y, int z) {
   return (static_cast<std::uint64_t>(x + kBias) << 42) | (static_cast<std::uint64_t>(y + kBias) << 21) |
          static_cast<std::uint64_t>(z + kBias);

@@ -22,6 +22,9 @@
 
 namespace varslam::dense {
 
+/// a / b rounded towards minus infinity (b > 0): the block or region holding a voxel at a negative index.
+inline int floor_div(int a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
+
 struct TsdfConfig {
   double voxel_size = 0.02;        // metres
   double truncation_voxels = 4.0;  // the truncation distance in voxels

@@ -8,6 +8,7 @@
 #include <map>
 #include <set>
 
+#include "core/elapsed.hpp"
 #include "optim/local_ba.hpp"
 #include "slam/ba_problem_builder.hpp"
 #include "slam/matcher.hpp"
@@ -16,7 +17,6 @@ namespace varslam::slam {
 
 namespace {
 using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
 /// Linear (DLT) triangulation from two camera-from-world poses and normalised image coordinates.
 bool triangulate_dlt(const Eigen::Isometry3d& T1, const Eigen::Isometry3d& T2, const Eigen::Vector2d& x1,

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <set>
 
+#include "core/elapsed.hpp"
 #include "optim/local_ba.hpp"
 #include "optim/pose_graph.hpp"
 #include "slam/ba_problem_builder.hpp"
@@ -15,7 +16,6 @@ namespace varslam::slam {
 
 namespace {
 using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
 double rotation_deg(const Eigen::Isometry3d& T) {
   return Eigen::AngleAxisd(T.rotation()).angle() * 180.0 / M_PI;

@@ -11,6 +11,7 @@
 #include <shared_mutex>
 #include <utility>
 
+#include "core/elapsed.hpp"
 #include "optim/pose_optimizer.hpp"
 #include "slam/ba_problem_builder.hpp"
 #include "slam/keyframe_localization.hpp"
@@ -21,9 +22,6 @@ namespace varslam::slam {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 constexpr int kMinKeypointsToInitialize = 500;  // enough structure to start a map (ORB-SLAM's rule)
 constexpr int kMinInliersMotion = 10;

@@ -7,6 +7,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "core/elapsed.hpp"
 #include "dense/dense_mapper.hpp"
 #include "viewer/viewer_messages.hpp"
 
@@ -14,8 +15,6 @@ namespace varslam::viewer {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
 
 // CPU time of the calling thread (ms): what an update costs, apart from the time an idle-priority thread waits.
 double thread_cpu_ms() {
