@@ -2,8 +2,8 @@
 # The sanitizer stage of the test suite (scripts/run_tests.sh runs it after the main suite):
 #  - AddressSanitizer + UndefinedBehaviorSanitizer (with the leak checker) on the unit and short end-to-end tests;
 #  - ThreadSanitizer on the tests that run threads (real-time pipeline, mapping errors, async detection, viewer).
-# Each in its own build tree at -O1 (build-asan, build-tsan; ccache when present), with line tables only (-g1:
-# reports still name file and line, and the trees compile about a third faster than with full -g). Any report fails the stage.
+# Each in its own build tree at -O1 (build-asan, build-tsan; ccache when present), with line tables only (-g1):
+# reports still name file and line, and the trees compile faster than with full -g. Any report fails the stage.
 # Suppressions, third-party code only: .ci/tsan.supp.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -39,9 +39,9 @@ for t in "${asan_tests[@]}"; do
   (cd build-asan && "${norandom[@]}" "./$t" --gtest_brief=1 --gtest_filter="$asan_skip")
 done
 
+echo "[sanitize] asan+ubsan tests done: $SECONDS s"
 echo "[sanitize] ThreadSanitizer"
 configure build-tsan "-fsanitize=thread"
-echo "[sanitize] asan+ubsan tests done: $SECONDS s"
 cmake --build build-tsan -j"$JOBS" --target test_pipeline test_slam test_semantic test_viewer test_api test_dense
 echo "[sanitize] tsan build done: $SECONDS s"
 export TSAN_OPTIONS="suppressions=$root/.ci/tsan.supp:halt_on_error=1:second_deadlock_stack=1"

@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 #include <variant>
 
+#include "core/elapsed.hpp"
 #include "core/error.hpp"
 #include "io/colour_registration.hpp"
 #include "io/depth_image.hpp"
@@ -50,7 +51,7 @@ DepthRegistrationEvent register_depth_if_needed(std::span<const RgbdFrame> sampl
   ev.score = reg.score;
   ev.identity_score = reg.identity_score;
   ev.frames = reg.frames;
-  ev.ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  ev.ms = ms_since(t0);
   if (reg.found) {
     DepthCameraRig rig;
     rig.depth = settings.camera;

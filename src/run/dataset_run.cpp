@@ -8,6 +8,7 @@
 #include <fstream>
 #include <thread>
 
+#include "core/elapsed.hpp"
 #include "core/error.hpp"
 #include "dense/dense_mapper.hpp"
 #include "eval/ate.hpp"
@@ -163,7 +164,7 @@ nlohmann::json write_dense_map(dense::DenseMapper& d, const std::filesystem::pat
   const auto t0 = Clock::now();
   const dense::Mesh mesh = d.mesh();
   const std::vector<dense::OccupancyVoxel> occ = d.occupancy();
-  const double extract_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  const double extract_ms = ms_since(t0);
   dense::write_mesh_ply(mesh, out_dir / "dense_mesh.ply");
   dense::write_octomap_bt(occ, d.config().tsdf.voxel_size, out_dir / "dense_map.bt");
   const dense::DenseStats st = d.stats();
@@ -230,7 +231,7 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const RunO
   if (options.load_map) {
     const auto t0 = Clock::now();
     slam.load_map(*options.load_map);
-    map_load_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    map_load_ms = ms_since(t0);
   }
   if (options.localization_only) slam.set_localization_only(true);
   slam.calibrate_depth(slam.wants_depth_samples() ? registration_samples(dataset, first, count)
@@ -257,7 +258,7 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const RunO
     const auto t_load = Clock::now();
     std::optional<RgbdFrame> frame = prefetch.next();
     if (!frame) break;
-    metrics.add_load_ms(std::chrono::duration<double, std::milli>(Clock::now() - t_load).count());
+    metrics.add_load_ms(ms_since(t_load));
     if (n == 0) first_stamp = frame->timestamp;
     Clock::time_point arrival = Clock::now();
     if (paced) {
@@ -272,7 +273,7 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const RunO
       std::this_thread::sleep_until(arrival);
     }
     slam.track(*frame);
-    if (realtime) metrics.add_latency_ms(std::chrono::duration<double, std::milli>(Clock::now() - arrival).count());
+    if (realtime) metrics.add_latency_ms(ms_since(arrival));
   }
   slam.finish();
   const double wall = std::chrono::duration<double>(Clock::now() - t_start).count();
@@ -340,7 +341,7 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const RunO
       const auto bytes = std::filesystem::file_size(*options.save_map, ec);
       m["map_file"] = {{"path", options.save_map->string()},
                        {"bytes", ec ? 0 : bytes},
-                       {"save_ms", std::chrono::duration<double, std::milli>(Clock::now() - t0).count()}};
+                       {"save_ms", ms_since(t0)}};
     } catch (const InputError& e) {
       // The run's results are still worth having: metrics and report are written, then the command fails.
       sum.map_error = e.what();
