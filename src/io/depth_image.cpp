@@ -41,15 +41,33 @@ double median_valid_depth(const cv::Mat& metres, int step) {
 
 namespace {
 
-// The pixel std::lround(x) names when it lies in [0, size), else -1. Without the library call: a truncating
-// conversion and the fraction left, which is exact in binary floating point (so half-way cases go away from zero,
-// as std::lround does). The library call took a third of the warp's time.
-int pixel_index(double x, int size) {
-  if (!(x > -0.5 && x < size - 0.5)) return -1;  // NaN fails too
-  int i = static_cast<int>(x);                     // toward zero
-  const double fraction = x - i;
-  if (fraction >= 0.5) ++i;
-  return i;
+// One row of the warp, arithmetic only: each pixel's target index in the colour image (-1: nothing lands) and its
+// depth there. Selects instead of branches, because holes and borders come in patterns the branch predictor misses;
+// the z-buffer stores are a second pass. The expressions are those of unproject() and project(), in the same
+// order, so the pixels are exactly theirs.
+void project_row(const float* depth, int cols, double v, const PinholeCamera& d, const Eigen::Vector3d& t,
+                 const PinholeCamera& colour, int* target, float* z_out) {
+  const double dcx = d.cx, dfx = d.fx, dfy = d.fy, tx = t.x(), ty = t.y(), tz = t.z();
+  const double fx = colour.fx, fy = colour.fy, cx = colour.cx, cy = colour.cy;
+  const double y_ray = v - d.cy, last_u = colour.width - 0.5, last_v = colour.height - 0.5;
+  const int width = colour.width;
+  for (int u = 0; u < cols; ++u) {
+    const double z = depth[u];
+    const double x = (u - dcx) * z / dfx + tx;
+    const double y = y_ray * z / dfy + ty;
+    const double zc = z + tz;
+    const bool in_front = (z > 0.0) & (zc > 0.0);  // & not &&: no branch
+    const double iz = 1.0 / (in_front ? zc : 1.0);
+    const double pu = fx * x * iz + cx;
+    const double pv = fy * y * iz + cy;
+    const bool inside = in_front & (pu > -0.5) & (pu < last_u) & (pv > -0.5) & (pv < last_v);
+    // Truncation and the exact fraction left round half away from zero, as std::lround does.
+    const double su = inside ? pu : 0.0, sv = inside ? pv : 0.0;
+    const int tu = static_cast<int>(su), tv = static_cast<int>(sv);
+    const int cu = tu + static_cast<int>(su - tu >= 0.5), cv_ = tv + static_cast<int>(sv - tv >= 0.5);
+    target[u] = inside ? cv_ * width + cu : -1;
+    z_out[u] = static_cast<float>(zc);
+  }
 }
 
 }  // namespace
@@ -57,22 +75,17 @@ int pixel_index(double x, int size) {
 cv::Mat register_depth_to_colour(const cv::Mat& depth_m, const DepthCameraRig& rig, const PinholeCamera& colour) {
   CV_Assert(depth_m.type() == CV_32FC1);
   cv::Mat out(colour.height, colour.width, CV_32FC1, cv::Scalar(0.0f));
-  const PinholeCamera& d = rig.depth;
-  const Eigen::Vector3d& t = rig.t_colour_depth;
+  CV_Assert(out.isContinuous());
+  auto* dst = out.ptr<float>();
+  std::vector<int> target(static_cast<std::size_t>(depth_m.cols));
+  std::vector<float> z(static_cast<std::size_t>(depth_m.cols));
   for (int v = 0; v < depth_m.rows; ++v) {
-    const auto* row = depth_m.ptr<float>(v);
+    project_row(depth_m.ptr<float>(v), depth_m.cols, v, rig.depth, rig.t_colour_depth, colour, target.data(), z.data());
     for (int u = 0; u < depth_m.cols; ++u) {
-      const float z = row[u];
-      if (!(z > 0.0f)) continue;
-      const Eigen::Vector3d p = d.unproject(u, v, z) + t;
-      if (p.z() <= 0.0) continue;
-      const Eigen::Vector2d uv = colour.project(p);
-      const int cu = pixel_index(uv.x(), out.cols);
-      const int cv_ = pixel_index(uv.y(), out.rows);
-      if (cu < 0 || cv_ < 0) continue;
-      float& dst = out.at<float>(cv_, cu);
-      const auto zc = static_cast<float>(p.z());
-      if (dst == 0.0f || zc < dst) dst = zc;  // z-buffer: the nearer surface occludes the farther one
+      const int i = target[std::size_t(u)];
+      if (i < 0) continue;
+      const float zc = z[std::size_t(u)];
+      if (dst[i] == 0.0f || zc < dst[i]) dst[i] = zc;  // z-buffer: the nearer surface occludes the farther one
     }
   }
   return out;
