@@ -18,7 +18,7 @@ STAGES = [  # (stage, library pattern, function pattern); the first match wins
     ('read: decode, depth, registration', r'libpng|libz\.|libjpeg|imgcodecs',
      r'register_depth_to_colour|project_row|llround|depth_to_metres|median_valid_depth|check_depth_scale'),
     ('ORB extraction', r'features2d',
-     r'rotated_brief|angle_deg|spread_keypoints|detect_fast_grid|fast_in_rect|OrbExtractor|build_pyramid|introsort|TaskPool'),
+     r'rotated_brief|angle_deg|spread_keypoints|detect_fast_grid|fast_in_rect|fast_in_cells|fast_score|OrbExtractor|build_pyramid|introsort|TaskPool'),
     ('optimisation: Local BA, pose', r'libceres',
      r'SchurLm|ceres|LocalBundle|local_ba|BarronKernel|KernelLoss|whitened_residual|linearize|log1p|expm1|'
      r'__ieee754_exp|Eigen::|ReprojectionCost|dpc_dpose|optimize_pose|Cost<'),

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <set>
 #include <tuple>
@@ -36,6 +37,63 @@ TEST(FastGrid, FallsBackToTheLowThresholdOnlyWhereNeeded) {
   // The strong half is not searched again: it keeps exactly its high-threshold corners.
   EXPECT_EQ(with_fallback.size() - std::size_t(on_right(with_fallback)), high_only.size());
   for (const auto& k : with_fallback) EXPECT_TRUE(region.contains(cv::Point(int(k.pt.x), int(k.pt.y))));
+}
+
+// The fallback as first written: one cv::FAST call per empty cell, on the cell grown by FAST's radius.
+std::vector<cv::KeyPoint> reference_fast_grid(const cv::Mat& image, const cv::Rect& region, const FastGridParams& p) {
+  const int cols = std::max(1, static_cast<int>(std::lround(region.width / double(p.cell_size))));
+  const int rows = std::max(1, static_cast<int>(std::lround(region.height / double(p.cell_size))));
+  std::vector<int> xs, ys;
+  for (int c = 0; c <= cols; ++c) xs.push_back(region.x + c * region.width / cols);
+  for (int r = 0; r <= rows; ++r) ys.push_back(region.y + r * region.height / rows);
+  const auto search = [&](const cv::Rect& rect, int threshold, std::vector<cv::KeyPoint>& out) {
+    std::vector<cv::KeyPoint> found;
+    const cv::Rect grown(rect.x - 3, rect.y - 3, rect.width + 6, rect.height + 6);
+    cv::FAST(image(grown), found, threshold, true);
+    for (cv::KeyPoint k : found) {
+      k.pt += cv::Point2f(float(grown.x), float(grown.y));
+      if (rect.contains(cv::Point(int(k.pt.x), int(k.pt.y)))) out.push_back(k);
+    }
+  };
+  std::vector<cv::KeyPoint> corners;
+  search(region, p.ini_threshold, corners);
+  std::vector<bool> occupied(std::size_t(cols * rows), false);
+  for (const auto& k : corners) {
+    const int c = int(std::upper_bound(xs.begin() + 1, xs.end() - 1, int(k.pt.x)) - xs.begin()) - 1;
+    const int r = int(std::upper_bound(ys.begin() + 1, ys.end() - 1, int(k.pt.y)) - ys.begin()) - 1;
+    occupied[std::size_t(r * cols + c)] = true;
+  }
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c)
+      if (!occupied[std::size_t(r * cols + c)])
+        search(cv::Rect(xs[std::size_t(c)], ys[std::size_t(r)], xs[std::size_t(c) + 1] - xs[std::size_t(c)],
+                        ys[std::size_t(r) + 1] - ys[std::size_t(r)]),
+               p.min_threshold, corners);
+  return corners;
+}
+
+TEST(FastGrid, EmptyCellsSearchedTogetherGiveTheCornersOfOneSearchPerCell) {
+  // Faint texture (between the two thresholds) over most of the image, strong blobs in a few places: long runs
+  // of empty cells side by side, corners on the borders between them, and plateaus of tied scores.
+  cv::RNG rng(5);
+  cv::Mat noise(240, 320, CV_8UC1);
+  rng.fill(noise, cv::RNG::UNIFORM, 92, 112);  // differences up to 19: under the first threshold
+  cv::Mat img = noise;
+  for (int i = 0; i < 6; ++i) cv::circle(img, cv::Point(rng.uniform(20, 300), rng.uniform(20, 220)), 5, cv::Scalar(220), cv::FILLED);
+  cv::rectangle(img, cv::Rect(100, 150, 90, 8), cv::Scalar(140), cv::FILLED);
+  for (const FastGridParams p : {FastGridParams{30, 20, 7}, FastGridParams{30, 20, 3}, FastGridParams{17, 40, 10}}) {
+    const cv::Rect region(16, 16, 288, 208);
+    std::vector<cv::KeyPoint> got;
+    detect_fast_grid(img, region, p, got);
+    const auto expected = reference_fast_grid(img, region, p);
+    ASSERT_EQ(got.size(), expected.size()) << "cell " << p.cell_size << ", thresholds " << p.min_threshold;
+    ASSERT_GT(got.size(), 100u) << "the faint texture gives the fallback work";
+    for (std::size_t i = 0; i < got.size(); ++i) {
+      EXPECT_EQ(got[i].pt, expected[i].pt) << i;
+      EXPECT_EQ(got[i].response, expected[i].response) << i;
+      EXPECT_EQ(got[i].size, expected[i].size) << i;
+    }
+  }
 }
 
 TEST(SpreadKeypoints, RoundRobinOverCellsBeforeSecondBest) {
