@@ -14,7 +14,7 @@ import re
 import subprocess
 import sys
 
-STAGES = [  # (stage, library pattern, function pattern); the first match wins
+STAGES = [  # (stage, library pattern, function pattern; None: none), the first match wins
     ('read: decode, depth, registration', r'libpng|libz\.|libjpeg|imgcodecs',
      r'register_depth_to_colour|project_row|llround|depth_to_metres|median_valid_depth|check_depth_scale'),
     ('ORB extraction', r'features2d',
@@ -22,17 +22,17 @@ STAGES = [  # (stage, library pattern, function pattern); the first match wins
     ('optimisation: Local BA, pose', r'libceres',
      r'SchurLm|ceres|LocalBundle|local_ba|BarronKernel|KernelLoss|whitened_residual|linearize|log1p|expm1|'
      r'__ieee754_exp|Eigen::|ReprojectionCost|dpc_dpose|optimize_pose|Cost<'),
-    ('matching', r'^$', r'match|in_area|FrameFeatures|search_by|hamming|popcount|descriptor_distance'),
-    ('image processing: blur, resize, colour', r'imgproc', r'^$'),
-    ('kernel', r'kernel', r'^$'),
-    ('libc: allocation, threads', r'libc\.|libstdc|ld-linux|libtbb|libgomp', r'^$'),
+    ('matching', None, r'match|in_area|FrameFeatures|search_by|hamming|popcount|descriptor_distance'),
+    ('image processing: blur, resize, colour', r'imgproc', None),
+    ('kernel', r'kernel', None),
+    ('libc: allocation, threads', r'libc\.|libstdc|ld-linux|libtbb|libgomp', None),
 ]
 OTHER = 'other: map, keyframes, covisibility'
 
 
 def stage_of(dso, symbol):
     for name, dso_pattern, symbol_pattern in STAGES:
-        if re.search(dso_pattern, dso) or re.search(symbol_pattern, symbol):
+        if (dso_pattern and re.search(dso_pattern, dso)) or (symbol_pattern and re.search(symbol_pattern, symbol)):
             return name
     return OTHER
 

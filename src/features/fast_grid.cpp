@@ -17,14 +17,18 @@ struct FastScratch {
   std::vector<std::uint8_t> scores;
 };
 
+// `rect` grown by FAST's circle radius on every side (within the image), so that FAST tests every pixel of `rect`.
+cv::Rect grown_for_fast(const cv::Rect& rect, const cv::Mat& image) {
+  return cv::Rect(rect.x - kFastRadius, rect.y - kFastRadius, rect.width + 2 * kFastRadius,
+                  rect.height + 2 * kFastRadius) &
+         cv::Rect(0, 0, image.cols, image.rows);
+}
+
 // Runs FAST on `rect` grown by the circle radius (so every pixel of `rect` is tested) and appends the
 // corners that fall inside `rect`, in image coordinates.
 void fast_in_rect(const cv::Mat& image, const cv::Rect& rect, int threshold, FastScratch& scratch,
                   std::vector<cv::KeyPoint>& out) {
-  const cv::Rect grown =
-      cv::Rect(rect.x - kFastRadius, rect.y - kFastRadius, rect.width + 2 * kFastRadius,
-               rect.height + 2 * kFastRadius) &
-      cv::Rect(0, 0, image.cols, image.rows);
+  const cv::Rect grown = grown_for_fast(rect, image);
   scratch.corners.clear();
   cv::FAST(image(grown), scratch.corners, threshold, true);
   for (cv::KeyPoint kp : scratch.corners) {
@@ -64,9 +68,7 @@ void fast_in_cells(const cv::Mat& image, const std::vector<int>& xs, int c_begin
                    int threshold, FastScratch& scratch, std::vector<cv::KeyPoint>& out) {
   const int x0 = xs[std::size_t(c_begin)], x1 = xs[std::size_t(c_end)];
   const int width = x1 - x0, height = y1 - y0;
-  const cv::Rect grown = cv::Rect(x0 - kFastRadius, y0 - kFastRadius, width + 2 * kFastRadius,
-                                  height + 2 * kFastRadius) &
-                         cv::Rect(0, 0, image.cols, image.rows);
+  const cv::Rect grown = grown_for_fast(cv::Rect(x0, y0, width, height), image);
   scratch.corners.clear();
   cv::FAST(image(grown), scratch.corners, threshold, false);
   scratch.scores.assign(std::size_t(width) * std::size_t(height), 0);
@@ -127,7 +129,6 @@ void detect_fast_grid(const cv::Mat& image, const cv::Rect& region, const FastGr
     occupied[static_cast<std::size_t>(r * cols + c)] = 1;
   }
   if (params.min_threshold >= params.ini_threshold) return;
-  const int threshold = std::clamp(params.min_threshold, 0, 255);  // as cv::FAST clamps it
   for (int r = 0; r < rows; ++r) {
     const auto ru = static_cast<std::size_t>(r);
     for (int c = 0; c < cols;) {
@@ -137,7 +138,7 @@ void detect_fast_grid(const cv::Mat& image, const cv::Rect& region, const FastGr
       }
       int end = c + 1;  // empty cells side by side share one FAST call
       while (end < cols && !occupied[static_cast<std::size_t>(r * cols + end)]) ++end;
-      fast_in_cells(image, xs, c, end, ys[ru], ys[ru + 1], threshold, scratch, corners);
+      fast_in_cells(image, xs, c, end, ys[ru], ys[ru + 1], params.min_threshold, scratch, corners);
       c = end;
     }
   }
