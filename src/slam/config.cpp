@@ -87,6 +87,7 @@ SlamConfig slam_config_from(const Settings& s) {
   t.min_inliers_local_map = setting<int>(s, "tracking.min_inliers");
   t.max_local_keyframes = setting<int>(s, "tracking.max_local_keyframes");
   t.depth_edge_ratio = setting<double>(s, "depth.edge_ratio");
+  t.rolling_shutter_s = setting<double>(s, "camera.rolling_shutter_ms") / 1000.0;
   t.depth_rig = read_depth_rig(s);
   t.estimate_registration = setting<std::string>(s, "depth.registration") == "auto";
   t.disparity_weight = setting<double>(s, "depth.disparity_weight");

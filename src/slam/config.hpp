@@ -68,6 +68,7 @@ struct TrackingConfig {
   int close_tracked_max = setting_keys::int_default("tracking.close_tracked_max");
   int close_untracked_min = setting_keys::int_default("tracking.close_untracked_min");
   double depth_edge_ratio = setting_keys::real_default("depth.edge_ratio");  // see frame.hpp
+  double rolling_shutter_s = setting_keys::real_default("camera.rolling_shutter_ms") / 1000.0;  // see rolling_shutter.hpp
   // Depth residual of pose optimisation and BA (optim::Observation): 0 = ORB-SLAM3's virtual right coordinate,
   // > 0 = the disparity bf/z alone with sigma 1/weight pixels at level 0.
   double disparity_weight = setting_keys::real_default("depth.disparity_weight");

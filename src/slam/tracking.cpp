@@ -16,6 +16,7 @@
 #include "slam/ba_problem_builder.hpp"
 #include "slam/keyframe_localization.hpp"
 #include "slam/matcher.hpp"
+#include "slam/rolling_shutter.hpp"
 
 namespace varslam::slam {
 
@@ -98,8 +99,15 @@ Frame Tracker::build_frame(const RgbdFrame& input, FrameTimings& t) {
     desc = kept_desc;
     t.filter_ms += ms_since(t0);
   }
+  const bool compensate = cfg_.tracking.rolling_shutter_s > 0 && state_ == TrackState::Ok && velocity_dt_ > 0;
+  std::vector<float> sensor_rows;
+  if (compensate)
+    for (const cv::KeyPoint& kp : kps) sensor_rows.push_back(kp.pt.y);
   auto features = make_frame_features(std::move(kps), desc, input.depth, camera_, close_depth_, scale_,
                                       cfg_.tracking.depth_edge_ratio);
+  if (compensate)
+    compensate_rolling_shutter(*features, sensor_rows, {cfg_.tracking.rolling_shutter_s, input.gray.rows}, velocity_,
+                               velocity_dt_);
   features->disparity_weight = cfg_.tracking.disparity_weight;
   return Frame(next_frame_id_++, input.timestamp, std::move(features));
 }
@@ -154,6 +162,7 @@ TrackOutcome Tracker::track(const RgbdFrame& input) {
     // After a loss (or before the first fix in a loaded map) the last pose was only predicted: no velocity can be
     // taken from it, and at frame rate standing still is the better guess.
     velocity_ = was_tracked ? cur.T_cw * last_.T_cw.inverse() : Eigen::Isometry3d::Identity();
+    velocity_dt_ = was_tracked ? cur.timestamp - last_.timestamp : 0.0;
     has_velocity_ = true;
     clean_temporary_matches(cur);
     record_fates(cur, out);
@@ -183,6 +192,7 @@ TrackOutcome Tracker::track(const RgbdFrame& input) {
       state_ = TrackState::Ok;
       lost_count_ = 0;
       has_velocity_ = false;
+      velocity_dt_ = 0;
       out.keyframe = true;
       out.new_segment = true;
       record(cur, true);

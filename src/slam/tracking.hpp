@@ -213,6 +213,7 @@ class Tracker {
   bool last_is_keyframe_ = false;
   Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();
   bool has_velocity_ = false;
+  double velocity_dt_ = 0;  // seconds velocity_ spans (0: not measured between two tracked frames)
   KeyFramePtr reference_kf_;
   long last_kf_frame_id_ = 0;
   long last_recovery_frame_id_ = -1000;
