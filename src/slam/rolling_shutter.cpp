@@ -19,18 +19,13 @@ void compensate_rolling_shutter(FrameFeatures& f, const std::vector<float>& sens
     const double share = shutter.readout_s * (double(sensor_rows[i]) / shutter.rows - 0.5) / dt;
     const Eigen::Matrix3d R = so3_exp(share * rotation);
     cv::KeyPoint& kp = f.keypoints[i];
-    Eigen::Vector3d at_middle;
-    if (f.has_depth(i)) {
-      const Eigen::Vector3d at_row = cam.unproject(kp.pt.x, kp.pt.y, f.depth[i]);
-      at_middle = R.transpose() * (at_row - share * translation);
-      if (at_middle.z() <= 0) continue;
-    } else {
-      at_middle = R.transpose() * cam.unproject(kp.pt.x, kp.pt.y, 1.0);
-      if (at_middle.z() <= 0) continue;
-    }
+    const bool with_depth = f.has_depth(i);
+    const Eigen::Vector3d at_row = cam.unproject(kp.pt.x, kp.pt.y, with_depth ? f.depth[i] : 1.0);
+    const Eigen::Vector3d at_middle = R.transpose() * (with_depth ? Eigen::Vector3d(at_row - share * translation) : at_row);
+    if (at_middle.z() <= 0) continue;
     const Eigen::Vector2d p = cam.project(at_middle);
     kp.pt = cv::Point2f(static_cast<float>(p.x()), static_cast<float>(p.y()));
-    if (f.has_depth(i)) {
+    if (with_depth) {
       f.depth[i] = static_cast<float>(at_middle.z());
       f.u_right[i] = static_cast<float>(p.x() - cam.bf / at_middle.z());
     }
