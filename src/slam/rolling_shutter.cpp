@@ -21,7 +21,8 @@ void compensate_rolling_shutter(FrameFeatures& f, const std::vector<float>& sens
     cv::KeyPoint& kp = f.keypoints[i];
     const bool with_depth = f.has_depth(i);
     const Eigen::Vector3d at_row = cam.unproject(kp.pt.x, kp.pt.y, with_depth ? f.depth[i] : 1.0);
-    const Eigen::Vector3d at_middle = R.transpose() * (with_depth ? Eigen::Vector3d(at_row - share * translation) : at_row);
+    const Eigen::Vector3d moved = with_depth ? Eigen::Vector3d(at_row - share * translation) : at_row;
+    const Eigen::Vector3d at_middle = R.transpose() * moved;
     if (at_middle.z() <= 0) continue;
     const Eigen::Vector2d p = cam.project(at_middle);
     kp.pt = cv::Point2f(static_cast<float>(p.x()), static_cast<float>(p.y()));
