@@ -92,7 +92,7 @@ inline constexpr KeySpec kKeys[] = {
     detail::positive("camera.fps", 30.0, 1000, "frame rate (Hz): pacing and the motion model's time step", "Camera.fps"),
     detail::optional_real("camera.baseline", 0.0, 10.0, "virtual stereo baseline (m) of the depth residual; when given, bf = fx * baseline", "(", "Stereo.b"),
     detail::positive("camera.bf", 40.0, 1e5, "fx times the virtual stereo baseline (pixels metres), used when camera.baseline is absent", "Camera.bf"),
-    detail::real("camera.rolling_shutter_ms", 0.0, 0.0, 1000.0, "colour readout time from the first row to the last (ms): keypoints are moved to the middle row's instant with the motion model; 0 = global shutter. Experimental: helps a rolling shutter alone, hurts beside lens distortion or a depth time offset (BENCHMARKS.md)"),
+    detail::real("camera.rolling_shutter_ms", 0.0, 0.0, 1000.0, "colour readout time from the first row to the last (ms): keypoints are moved to the middle row's instant, first with the motion model, then with the motion the frame's own pose solve measured (solved again); 0 = global shutter"),
 
     // depth: how raw depth becomes metres and how far it is trusted.
     detail::positive("depth.factor", 5000.0, 1e6, "raw depth units per metre (TUM/Bonn 5000, OpenLORIS/7-Scenes 1000)", "RGBD.DepthMapFactor|DepthMapFactor"),

@@ -99,17 +99,36 @@ Frame Tracker::build_frame(const RgbdFrame& input, FrameTimings& t) {
     desc = kept_desc;
     t.filter_ms += ms_since(t0);
   }
-  const bool compensate = cfg_.tracking.rolling_shutter_s > 0 && state_ == TrackState::Ok && velocity_dt_ > 0;
+  const bool rolling = cfg_.tracking.rolling_shutter_s > 0;
   std::vector<float> sensor_rows;
-  if (compensate)
+  if (rolling)
     for (const cv::KeyPoint& kp : kps) sensor_rows.push_back(kp.pt.y);
   auto features = make_frame_features(std::move(kps), desc, input.depth, camera_, close_depth_, scale_,
                                       cfg_.tracking.depth_edge_ratio);
-  if (compensate)
-    compensate_rolling_shutter(*features, sensor_rows, {cfg_.tracking.rolling_shutter_s, input.gray.rows}, velocity_,
-                               velocity_dt_);
   features->disparity_weight = cfg_.tracking.disparity_weight;
+  if (rolling) {
+    shutter_source_.features = std::make_shared<const FrameFeatures>(*features);
+    shutter_source_.sensor_rows = std::move(sensor_rows);
+    shutter_source_.image_rows = input.gray.rows;
+    if (state_ == TrackState::Ok && velocity_dt_ > 0) compensate_with(*features, velocity_, velocity_dt_);
+  }
   return Frame(next_frame_id_++, input.timestamp, std::move(features));
+}
+
+void Tracker::compensate_with(FrameFeatures& f, const Eigen::Isometry3d& motion, double dt) const {
+  compensate_rolling_shutter(f, shutter_source_.sensor_rows,
+                             {cfg_.tracking.rolling_shutter_s, shutter_source_.image_rows}, motion, dt);
+}
+
+void Tracker::refine_rolling_shutter(Frame& cur, FrameTimings& t) {
+  const double dt = cur.timestamp - last_.timestamp;
+  if (!shutter_source_.features || dt <= 0) return;
+  // The first solve compensated with the previous interval's velocity; the frame's own motion, now measured, is the
+  // better estimate of how the camera moved while its rows were read.
+  auto features = std::make_shared<FrameFeatures>(*shutter_source_.features);
+  compensate_with(*features, cur.T_cw * last_.T_cw.inverse(), dt);
+  cur.features = std::move(features);
+  optimize_and_discard(cur, t);
 }
 
 TrackOutcome Tracker::track(const RgbdFrame& input) {
@@ -151,6 +170,10 @@ TrackOutcome Tracker::track(const RgbdFrame& input) {
     ok = recover(cur, out.timings);
   }
   if (ok) ok = track_local_map(cur, out.timings);
+  if (ok && was_tracked && cfg_.tracking.rolling_shutter_s > 0) {
+    refine_rolling_shutter(cur, out.timings);
+    out.features = cur.features;
+  }
 
   if (ok) {
     state_ = TrackState::Ok;

@@ -140,6 +140,11 @@ class Tracker {
 
  private:
   Frame build_frame(const RgbdFrame& input, FrameTimings& t);
+  /// Rolling-shutter compensation of `f` (the frame being tracked) with the camera motion `motion` over `dt`.
+  void compensate_with(FrameFeatures& f, const Eigen::Isometry3d& motion, double dt) const;
+  /// After the local-map solve: compensates the frame's keypoints again with the motion that solve measured
+  /// (last frame to this one) and solves the pose again on the same matches.
+  void refine_rolling_shutter(Frame& cur, FrameTimings& t);
   bool initialize(Frame& cur, const Eigen::Isometry3d& T_cw);
   void refresh_last_frame(long frame_id);
   static void record_fates(const Frame& cur, TrackOutcome& out);
@@ -224,6 +229,11 @@ class Tracker {
   int relocalizations_ = 0;
   int placed_back_ = 0;
   long near_mover_frames_ = 0;
+  struct ShutterSource {
+    std::shared_ptr<const FrameFeatures> features;  // the frame being tracked, before compensation
+    std::vector<float> sensor_rows;                 // its keypoints' rows on the sensor
+    int image_rows = 0;
+  } shutter_source_;  // kept only with tracking.rolling_shutter_s > 0
   MoverTrack mover_track_;  // the near mover being followed (slam/mover_track.hpp)
   LostFrameChain lost_chain_;  // the frames since the loss, in a map this session did not build
   LostFrameChain::Added chain_step_;  // what adding the frame being tracked did to the chain

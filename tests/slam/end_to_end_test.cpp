@@ -39,7 +39,8 @@ fs::path test_dir(const std::string& name) {
 // A synthetic sequence along one of the real camera paths in ../shared/trajectories, cached under `name`;
 // empty when ../shared is absent.
 fs::path path_sequence(const std::string& name, const std::string& path_name, const std::string& scenario,
-                       double seconds, std::uint64_t seed, double path_start) {
+                       double seconds, std::uint64_t seed, double path_start,
+                       const synth::RealSensorEffects& real = {}) {
   const fs::path path = fs::path(VARSLAM_SHARED_DIR) / "trajectories" / path_name;
   if (!fs::exists(path)) return {};
   synth::SynthConfig cfg;
@@ -48,6 +49,7 @@ fs::path path_sequence(const std::string& name, const std::string& path_name, co
   cfg.seed = seed;
   cfg.path_file = path;
   cfg.path_start = path_start;
+  cfg.real = real;
   return cached_sequence(name, cfg);
 }
 
@@ -212,6 +214,24 @@ TEST(EndToEnd, BoxFlyingPastIsNotFollowed) {
       path_sequence("box_flying_past_3s", "rgbd_dataset_freiburg3_sitting_static", "unknown_box", 3.0, 2, 10.3);
   if (seq.empty()) GTEST_SKIP() << "camera paths not found under " << VARSLAM_SHARED_DIR << " (../shared is absent)";
   expect_tracked_with_ate_below(run_on(seq, test_dir("box_flying_past"), RunMode::Deterministic, 30), 0.02);
+}
+
+// The first 3 s of fr1/desk (hand-held, turning ~25 deg/s) seen by a colour camera that reads its rows out over
+// 30 ms: the top and bottom rows see the desk ~0.75 deg apart. Compensated with the motion each frame's own solve
+// measures, the error falls to under half (seed 1: 4.95 -> 1.93 cm); compensated with the previous interval's
+// motion alone it fell only to 3.68.
+TEST(EndToEnd, RollingShutterIsCompensatedWithTheFramesOwnMotion) {
+  synth::RealSensorEffects shutter;
+  shutter.rolling_shutter_s = 0.03;
+  const fs::path seq =
+      path_sequence("desk_rolling_shutter_30ms", "rgbd_dataset_freiburg1_desk", "static", 3.0, 1, 0.0, shutter);
+  if (seq.empty()) GTEST_SKIP() << "camera paths not found under " << VARSLAM_SHARED_DIR << " (../shared is absent)";
+  const RunSummary off = run_on(seq, test_dir("shutter_off"), RunMode::Deterministic);
+  const RunSummary on = run_on(seq, test_dir("shutter_on"), RunMode::Deterministic, SIZE_MAX,
+                               {"camera.rolling_shutter_ms=30"});
+  EXPECT_EQ(on.tracked, on.frames);
+  ASSERT_TRUE(off.ate_rmse && on.ate_rmse);
+  EXPECT_LT(*on.ate_rmse, 0.5 * *off.ate_rmse) << "compensated " << *on.ate_rmse << " m, not " << *off.ate_rmse;
 }
 
 TEST(EndToEnd, RealKitchenExcerpt) {
