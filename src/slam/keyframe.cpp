@@ -1,6 +1,8 @@
 #include "slam/keyframe.hpp"
 
 #include <algorithm>
+#include <utility>
+#include <vector>
 
 namespace varslam::slam {
 
@@ -27,11 +29,24 @@ void KeyFrame::set_pose(const Eigen::Isometry3d& T_cw) {
 }
 
 Eigen::Isometry3d KeyFrame::resolved_pose() const {
-  if (!is_bad()) return pose();
-  const KeyFramePtr p = parent();
-  if (!p) return pose();
-  std::lock_guard lock(pose_mutex_);
-  return T_c_parent_ * p->resolved_pose();
+  // Up the chain of culled keyframes to the first live one, one pose lock at a time. The chain is walked, not
+  // recursed, and a keyframe met twice ends it: a cycle among culled keyframes must not wait on a held lock.
+  Eigen::Isometry3d T_c_k = Eigen::Isometry3d::Identity();
+  const KeyFrame* k = this;
+  KeyFramePtr hold;  // keeps k alive
+  std::vector<const KeyFrame*> visited;
+  while (k->is_bad()) {
+    KeyFramePtr p = k->parent();
+    if (!p || std::find(visited.begin(), visited.end(), p.get()) != visited.end() || p.get() == this) break;
+    visited.push_back(k);
+    {
+      std::lock_guard lock(k->pose_mutex_);
+      T_c_k = T_c_k * k->T_c_parent_;
+    }
+    hold = std::move(p);
+    k = hold.get();
+  }
+  return T_c_k * k->pose();
 }
 
 std::vector<MapPointPtr> KeyFrame::map_points() const {
@@ -177,10 +192,15 @@ void KeyFrame::erase_child(const KeyFramePtr& kf) {
 }
 
 void KeyFrame::change_parent(const KeyFramePtr& kf) {
+  // A keyframe is never its own parent: set_bad() would wait on its own pose lock through it.
+  if (!kf || kf.get() == this) return;
+  KeyFramePtr old;
   {
     std::lock_guard lock(graph_mutex_);
-    parent_ = kf;
+    old = std::exchange(parent_, kf);
   }
+  // The old parent forgets the child, or culling it later would hand the child back a parent (itself, even).
+  if (old && old != kf) old->erase_child(shared_from_this());
   kf->add_child(shared_from_this());
 }
 
@@ -246,11 +266,12 @@ void KeyFrame::set_bad() {
     children.erase(best_child);
   }
   for (const auto& child : children)
-    if (parent) child->change_parent(parent);
+    if (parent && child != parent) child->change_parent(parent);
   if (parent) {
     parent->erase_child(self);
+    const Eigen::Isometry3d T_parent_w = parent->pose_inverse();  // before taking this one's pose lock
     std::lock_guard lock(pose_mutex_);
-    T_c_parent_ = T_cw_ * parent->pose_inverse();
+    T_c_parent_ = T_cw_ * T_parent_w;
   }
 
   std::lock_guard lock(graph_mutex_);

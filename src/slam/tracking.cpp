@@ -128,7 +128,26 @@ void Tracker::refine_rolling_shutter(Frame& cur, FrameTimings& t) {
   auto features = std::make_shared<FrameFeatures>(*shutter_source_.features);
   compensate_with(*features, cur.T_cw * last_.T_cw.inverse(), dt);
   cur.features = std::move(features);
-  optimize_and_discard(cur, t);
+  // The pose alone is solved again, on the first solve's inliers: which matches are outliers or on a mover was
+  // decided there, and deciding it twice per frame would let the mover follower confirm a mover twice.
+  const auto t0 = Clock::now();
+  FramePoseProblem p = frame_pose_problem(cur);
+  FramePoseProblem inliers;
+  for (std::size_t k = 0; k < p.keypoints.size(); ++k) {
+    if (cur.outlier[p.keypoints[k]]) continue;
+    inliers.points.push_back(p.points[k]);
+    inliers.observations.push_back(p.observations[k]);
+    inliers.keypoints.push_back(p.keypoints[k]);
+  }
+  if (inliers.keypoints.size() >= 3) {
+    optim::PoseOptimConfig pc;
+    pc.kernel = cfg_.tracking.kernel;
+    pc.solver = optim::PoseSolver::Dedicated;
+    Eigen::Isometry3d T_cw = cur.T_cw;
+    const optim::PoseOptimResult res = optim::optimize_pose(camera_, T_cw, inliers.points, inliers.observations, pc);
+    if (res.inliers >= kMinInliersMotion) cur.T_cw = T_cw;
+  }
+  t.pose_ms += ms_since(t0);
 }
 
 TrackOutcome Tracker::track(const RgbdFrame& input) {

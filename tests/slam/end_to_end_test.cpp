@@ -218,7 +218,7 @@ TEST(EndToEnd, BoxFlyingPastIsNotFollowed) {
 
 // The first 3 s of fr1/desk (hand-held, turning ~25 deg/s) seen by a colour camera that reads its rows out over
 // 30 ms: the top and bottom rows see the desk ~0.75 deg apart. Compensated with the motion each frame's own solve
-// measures, the error falls to under half (seed 1: 4.95 -> 1.93 cm); compensated with the previous interval's
+// measures, the error falls to under half (seed 1: 4.95 -> 1.87 cm); compensated with the previous interval's
 // motion alone it fell only to 3.68.
 TEST(EndToEnd, RollingShutterIsCompensatedWithTheFramesOwnMotion) {
   synth::RealSensorEffects shutter;

@@ -94,6 +94,42 @@ TEST(Map, CulledKeyframeDetachesAndReparentsChildren) {
   m.map.clear();
 }
 
+// A keyframe reparented twice (loop closing, culling) must not stay a child of its first parent: culling that one
+// then handed it back as a child's new parent, here its own parent, and culling it afterwards waited forever on
+// its own pose lock.
+TEST(Map, CullingAfterReparentingNeverMakesAKeyframeItsOwnParent) {
+  SmallMap m;
+  build(m);
+  m.kfs[1]->change_parent(m.kfs[2]);
+  m.kfs[1]->change_parent(m.kfs[0]);
+  EXPECT_TRUE(m.kfs[2]->children().empty());
+  m.kfs[2]->change_parent(m.kfs[1]);  // kfs[1] was kfs[2]'s child: now it is its parent
+  m.kfs[2]->set_bad();
+  ASSERT_NE(m.kfs[1]->parent().get(), m.kfs[1].get());
+  m.kfs[1]->set_bad();  // returns
+  EXPECT_TRUE(m.kfs[1]->is_bad());
+  m.kfs[0]->change_parent(m.kfs[0]);
+  EXPECT_NE(m.kfs[0]->parent().get(), m.kfs[0].get());
+  m.map.clear();
+}
+
+// Culled keyframes whose parents point at each other (a spanning tree bent into a cycle): their resolved poses are
+// still answered, from where the cycle closes, instead of waiting forever on a lock held up the chain.
+TEST(Map, ResolvedPoseOfACycleOfCulledKeyframesReturns) {
+  SmallMap m;
+  build(m);
+  m.kfs[2]->change_parent(m.kfs[1]);
+  m.kfs[1]->set_bad();  // kfs[2] is handed to kfs[0]
+  m.kfs[2]->set_bad();
+  m.kfs[1]->change_parent(m.kfs[2]);
+  m.kfs[2]->change_parent(m.kfs[1]);
+  ASSERT_EQ(m.kfs[1]->parent(), m.kfs[2]);
+  ASSERT_EQ(m.kfs[2]->parent(), m.kfs[1]);
+  EXPECT_TRUE(m.kfs[1]->resolved_pose().matrix().allFinite());
+  EXPECT_TRUE(m.kfs[2]->resolved_pose().matrix().allFinite());
+  m.map.clear();
+}
+
 TEST(Map, ReplaceMovesObservationsToSurvivor) {
   SmallMap m;
   build(m);
