@@ -36,9 +36,9 @@ Eigen::Isometry3d KeyFrame::resolved_pose() const {
   KeyFramePtr hold;  // keeps k alive
   std::vector<const KeyFrame*> visited;
   while (k->is_bad()) {
-    KeyFramePtr p = k->parent();
-    if (!p || std::find(visited.begin(), visited.end(), p.get()) != visited.end() || p.get() == this) break;
     visited.push_back(k);
+    KeyFramePtr p = k->parent();
+    if (!p || std::find(visited.begin(), visited.end(), p.get()) != visited.end()) break;
     {
       std::lock_guard lock(k->pose_mutex_);
       T_c_k = T_c_k * k->T_c_parent_;

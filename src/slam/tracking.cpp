@@ -140,11 +140,9 @@ void Tracker::refine_rolling_shutter(Frame& cur, FrameTimings& t) {
     inliers.keypoints.push_back(p.keypoints[k]);
   }
   if (inliers.keypoints.size() >= 3) {
-    optim::PoseOptimConfig pc;
-    pc.kernel = cfg_.tracking.kernel;
-    pc.solver = optim::PoseSolver::Dedicated;
     Eigen::Isometry3d T_cw = cur.T_cw;
-    const optim::PoseOptimResult res = optim::optimize_pose(camera_, T_cw, inliers.points, inliers.observations, pc);
+    const optim::PoseOptimResult res =
+        optim::optimize_pose(camera_, T_cw, inliers.points, inliers.observations, pose_config());
     if (res.inliers >= kMinInliersMotion) cur.T_cw = T_cw;
   }
   t.pose_ms += ms_since(t0);
@@ -340,6 +338,15 @@ void Tracker::refresh_last_frame(long frame_id) {
   }
 }
 
+optim::PoseOptimConfig Tracker::pose_config() const {
+  optim::PoseOptimConfig pc;
+  pc.kernel = cfg_.tracking.kernel;
+  // The dedicated 6-DoF solver gives the same pose as Ceres (tested against it) at 1.5-2x less cost.
+  pc.solver = optim::PoseSolver::Dedicated;
+  pc.observer = cfg_.tracking.pose_observer;
+  return pc;
+}
+
 int Tracker::optimize_and_discard(Frame& cur, FrameTimings& t) {
   const auto t0 = Clock::now();
   const FramePoseProblem p = frame_pose_problem(cur);
@@ -359,11 +366,7 @@ int Tracker::optimize_and_discard(Frame& cur, FrameTimings& t) {
   }
   const bool trust_established = cfg_.tracking.established_found > 0 && established >= kMinEstablished;
 
-  optim::PoseOptimConfig pc;
-  pc.kernel = cfg_.tracking.kernel;
-  // The dedicated 6-DoF solver gives the same pose as Ceres (tested against it) at 1.5-2x less cost.
-  pc.solver = optim::PoseSolver::Dedicated;
-  pc.observer = cfg_.tracking.pose_observer;
+  const optim::PoseOptimConfig pc = pose_config();
   auto res = suspect.empty() ? optim::optimize_pose(camera_, cur.T_cw, p.points, p.observations, pc,
                                                     trust_established ? &young : nullptr)
                              : solve_without_suspects(cur, p, pc, suspect, trust_established ? &young : nullptr);

@@ -143,8 +143,10 @@ class Tracker {
   /// Rolling-shutter compensation of `f` (the frame being tracked) with the camera motion `motion` over `dt`.
   void compensate_with(FrameFeatures& f, const Eigen::Isometry3d& motion, double dt) const;
   /// After the local-map solve: compensates the frame's keypoints again with the motion that solve measured
-  /// (last frame to this one) and solves the pose again on the same matches.
+  /// (last frame to this one) and solves the pose alone again on that solve's inliers.
   void refine_rolling_shutter(Frame& cur, FrameTimings& t);
+  /// How tracking solves a frame's pose (kernel, solver, the pose observer).
+  optim::PoseOptimConfig pose_config() const;
   bool initialize(Frame& cur, const Eigen::Isometry3d& T_cw);
   void refresh_last_frame(long frame_id);
   static void record_fates(const Frame& cur, TrackOutcome& out);
