@@ -371,6 +371,11 @@ void check_references(const Reader& r, const SavedMap& m) {
       kf_side.emplace(k.id, idx);
     }
   }
+  for (const auto& k : m.keyframes) {  // the spanning tree must be a tree: each parent chain ends
+    std::set<long> chain{k.id};
+    for (long id = k.parent; id != -1; id = kfs.at(id)->parent)
+      if (!chain.insert(id).second) r.fail(fmt::format("keyframe {}", k.id), "its parent chain loops back");
+  }
   std::size_t links = 0;
   for (const auto& p : m.map_points) {
     const std::string w = fmt::format("map point {}", p.id);

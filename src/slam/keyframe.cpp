@@ -1,14 +1,25 @@
 #include "slam/keyframe.hpp"
 
 #include <algorithm>
+#include <set>
 #include <utility>
 #include <vector>
 
 namespace varslam::slam {
 
 namespace {
+
 constexpr int kCovisibilityMinWeight = 15;  // shared points for a covisibility edge (ORB-SLAM's value)
+
+// Whether `ancestor` is on kf's parent chain; a cycle already in the chain ends the walk.
+bool descends_from(const KeyFramePtr& kf, const KeyFrame* ancestor) {
+  std::set<const KeyFrame*> seen;
+  for (KeyFramePtr k = kf; k && seen.insert(k.get()).second; k = k->parent())
+    if (k.get() == ancestor) return true;
+  return false;
 }
+
+}  // namespace
 
 KeyFrame::KeyFrame(long id, const Frame& frame)
     : id_(id), frame_id_(frame.id), timestamp_(frame.timestamp), features_(frame.features), T_cw_(frame.T_cw),
@@ -105,15 +116,32 @@ void KeyFrame::update_connections() {
   }
   if (best_weight < kCovisibilityMinWeight) best->add_connection(shared_from_this(), best_weight);
 
-  std::lock_guard lock(graph_mutex_);
-  connections_.clear();
-  for (const auto& [kf, w] : counter)
-    if (w >= kCovisibilityMinWeight || kf == best) connections_[kf] = w;
-  sort_connections_locked();
-  if (first_connection_ && id_ != 0) {
-    parent_ = ordered_covisibles_.front();
-    parent_->add_child(shared_from_this());
-    first_connection_ = false;
+  std::vector<KeyFramePtr> parent_candidates;
+  {
+    std::lock_guard lock(graph_mutex_);
+    connections_.clear();
+    for (const auto& [kf, w] : counter)
+      if (w >= kCovisibilityMinWeight || kf == best) connections_[kf] = w;
+    sort_connections_locked();
+    if (!first_connection_ || id_ == 0) return;
+    parent_candidates = ordered_covisibles_;
+  }
+  choose_first_parent(parent_candidates);
+}
+
+void KeyFrame::choose_first_parent(const std::vector<KeyFramePtr>& heaviest_first) {
+  // A keyframe whose first connection came late (it shared no point when inserted) may already be a newer
+  // keyframe's parent: taking one of its own descendants would bend the spanning tree into a cycle.
+  for (const auto& candidate : heaviest_first) {
+    if (descends_from(candidate, this)) continue;
+    {
+      std::lock_guard lock(graph_mutex_);
+      if (!first_connection_) return;
+      parent_ = candidate;
+      first_connection_ = false;
+    }
+    candidate->add_child(shared_from_this());
+    return;
   }
 }
 

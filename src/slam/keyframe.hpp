@@ -108,6 +108,7 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   std::atomic<bool> not_erase_{false};
 
   void sort_connections_locked();
+  void choose_first_parent(const std::vector<std::shared_ptr<KeyFrame>>& heaviest_first);
 };
 
 using KeyFramePtr = std::shared_ptr<KeyFrame>;

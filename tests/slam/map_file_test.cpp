@@ -164,6 +164,11 @@ TEST(MapFile, BrokenOrForeignFilesAreRefusedByName) {
   m = decode_map(good, "good");
   m.keyframes.front().T_cw.linear() *= 2.0;
   EXPECT_THAT(decode_error(encode_map(m)), HasSubstr("not a rotation"));
+  m = decode_map(good, "good");
+  ASSERT_GE(m.keyframes.size(), 3u);
+  m.keyframes[1].parent = m.keyframes[2].id;
+  m.keyframes[2].parent = m.keyframes[1].id;
+  EXPECT_THAT(decode_error(encode_map(m)), HasSubstr("parent chain loops back"));
 
   EXPECT_THROW(load_map_file(temp_path("no_such.map")), InputError);
 }

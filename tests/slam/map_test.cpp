@@ -35,8 +35,8 @@ struct SmallMap {
   std::vector<MapPointPtr> points;
 };
 
-// Three keyframes that all observe the same 20 points.
-void build(SmallMap& m, int n_points = 20) {
+// Three keyframes that all observe the same 20 points; `connect` builds their covisibility graph.
+void build(SmallMap& m, int n_points = 20, bool connect = true) {
   for (int k = 0; k < 3; ++k) m.kfs.push_back(std::make_shared<KeyFrame>(m.map.next_keyframe_id(), frame_with_points(k, n_points)));
   for (int i = 0; i < n_points; ++i) {
     auto mp = std::make_shared<MapPoint>(m.map.next_map_point_id(), Eigen::Vector3d(i * 0.1, 0, 2), m.kfs[0]);
@@ -50,7 +50,8 @@ void build(SmallMap& m, int n_points = 20) {
   for (auto& kf : m.kfs) {
     m.map.add_keyframe(kf);
   }
-  for (auto& kf : m.kfs) kf->update_connections();
+  if (connect)
+    for (auto& kf : m.kfs) kf->update_connections();
 }
 
 TEST(Map, CovisibilityWeightsCountSharedPoints) {
@@ -110,6 +111,24 @@ TEST(Map, CullingAfterReparentingNeverMakesAKeyframeItsOwnParent) {
   EXPECT_TRUE(m.kfs[1]->is_bad());
   m.kfs[0]->change_parent(m.kfs[0]);
   EXPECT_NE(m.kfs[0]->parent().get(), m.kfs[0].get());
+  m.map.clear();
+}
+
+// A keyframe connected late (it shared no point when inserted) may already be a newer keyframe's parent; its first
+// parent is then the heaviest covisible that does not descend from it, never its own child.
+TEST(Map, ALateFirstConnectionNeverChoosesADescendantAsParent) {
+  SmallMap m;
+  build(m, 20, false);
+  for (int i = 0; i < 5; ++i) {  // kfs[0] shares 15 points with the others, kfs[1] and kfs[2] share 20
+    m.points[static_cast<std::size_t>(i)]->erase_observation(m.kfs[0]);
+    m.kfs[0]->erase_map_point(i);
+  }
+  m.kfs[2]->update_connections();
+  ASSERT_EQ(m.kfs[2]->parent(), m.kfs[1]);
+  m.kfs[1]->update_connections();  // its heaviest covisible is its child kfs[2]
+  EXPECT_EQ(m.kfs[1]->parent(), m.kfs[0]);
+  EXPECT_EQ(m.kfs[2]->parent(), m.kfs[1]);
+  EXPECT_EQ(m.kfs[1]->children().count(m.kfs[2]), 1u);
   m.map.clear();
 }
 
