@@ -57,7 +57,7 @@ double linearize(const PinholeCamera& cam, const Eigen::Isometry3d& T, const std
     ne->H_radial.setZero();
     ne->b.setZero();
   }
-  double e[3], rho[3];
+  double e[3] = {}, rho[3] = {};  // zeroed: GCC cannot see that evaluate() always writes rho
   Eigen::Matrix3d de_dpc;
   for (std::size_t i = 0; i < obs.size(); ++i) {
     if (!active[i]) continue;
