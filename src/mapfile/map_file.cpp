@@ -371,10 +371,14 @@ void check_references(const Reader& r, const SavedMap& m) {
       kf_side.emplace(k.id, idx);
     }
   }
-  for (const auto& k : m.keyframes) {  // the spanning tree must be a tree: each parent chain ends
-    std::set<long> chain{k.id};
-    for (long id = k.parent; id != -1; id = kfs.at(id)->parent)
+  // The spanning tree must be a tree: each parent chain ends. A chain is walked only up to a keyframe already
+  // known to reach the root, so a long chain costs its length once, not once per keyframe on it.
+  std::set<long> reaches_root;
+  for (const auto& k : m.keyframes) {
+    std::set<long> chain;
+    for (long id = k.id; id != -1 && !reaches_root.count(id); id = kfs.at(id)->parent)
       if (!chain.insert(id).second) r.fail(fmt::format("keyframe {}", k.id), "its parent chain loops back");
+    reaches_root.insert(chain.begin(), chain.end());
   }
   std::size_t links = 0;
   for (const auto& p : m.map_points) {
