@@ -3,12 +3,11 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
-#include <array>
 #include <atomic>
 #include <cerrno>
 #include <cstring>
-#include <fstream>
-#include <opencv2/imgcodecs.hpp>
+#include <optional>
+#include <span>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 #include <utility>
@@ -18,6 +17,7 @@
 #include "io/depth_image.hpp"
 #include "io/file_problem.hpp"
 #include "io/frame_list.hpp"
+#include "io/image_decoding.hpp"
 
 namespace varslam {
 namespace {
@@ -73,15 +73,13 @@ class ListedRgbdDataset final : public Dataset {
     out.depth_path = (root_ / f.depth.path).string();
 
     check_exists(f.rgb, out.rgb_path);
-    check_image_format(f.rgb, out.rgb_path);
-    out.bgr = cv::imread(out.rgb_path, cv::IMREAD_COLOR);
+    out.bgr = decode_colour_image(read_image_file(f.rgb, out.rgb_path));
     if (out.bgr.empty()) throw InputError(fmt::format("{}: cannot decode image {}", f.rgb.where, out.rgb_path));
     check_size(out.bgr, f.rgb, out.rgb_path);
     cv::cvtColor(out.bgr, out.gray, cv::COLOR_BGR2GRAY);
 
     check_exists(f.depth, out.depth_path);
-    check_image_format(f.depth, out.depth_path);
-    const cv::Mat raw = cv::imread(out.depth_path, cv::IMREAD_UNCHANGED);
+    const cv::Mat raw = decode_unchanged_image(read_image_file(f.depth, out.depth_path));
     if (raw.empty())
       throw InputError(fmt::format("{}: cannot decode depth image {}", f.depth.where, out.depth_path));
     if (raw.type() != CV_16UC1)
@@ -126,16 +124,15 @@ class ListedRgbdDataset final : public Dataset {
 
   // OpenCV picks a decoder by the file's content, whatever its name, and some it links abort on malformed input
   // (its DICOM reader asserts; found by fuzzing): only PNG and JPEG files, the formats RGB-D datasets use, reach it.
-  static void check_image_format(const ListEntry& e, const std::string& path) {
-    std::array<unsigned char, 132> head{};
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw InputError(fmt::format("{}: cannot read image {}: {}", e.where, path, describe_errno(errno)));
-    in.read(reinterpret_cast<char*>(head.data()), head.size());
-    const auto n = static_cast<std::size_t>(in.gcount());
-    const bool png = n >= 8 && std::memcmp(head.data(), "\x89PNG\r\n\x1a\n", 8) == 0;
-    const bool jpeg = n >= 3 && head[0] == 0xFF && head[1] == 0xD8 && head[2] == 0xFF;
-    const bool dicom = n >= 132 && std::memcmp(head.data() + 128, "DICM", 4) == 0;  // tried before PNG/JPEG
-    if ((png || jpeg) && !dicom) return;
+  // The file's bytes, once it is known to be a PNG or JPEG (what the decoders read).
+  static std::vector<std::uint8_t> read_image_file(const ListEntry& e, const std::string& path) {
+    std::optional<std::vector<std::uint8_t>> bytes = read_file_bytes(path);
+    if (!bytes) throw InputError(fmt::format("{}: cannot read image {}: {}", e.where, path, describe_errno(errno)));
+    const std::span<const std::uint8_t> head(*bytes);
+    const bool png = head.size() >= 8 && std::memcmp(head.data(), "\x89PNG\r\n\x1a\n", 8) == 0;
+    const bool jpeg = head.size() >= 3 && head[0] == 0xFF && head[1] == 0xD8 && head[2] == 0xFF;
+    const bool dicom = head.size() >= 132 && std::memcmp(head.data() + 128, "DICM", 4) == 0;  // tried before PNG/JPEG
+    if ((png || jpeg) && !dicom) return std::move(*bytes);
     throw InputError(fmt::format("{}: {} is not a PNG or JPEG image", e.where, path));
   }
 

@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.hpp"
+#include "io/image_decoding.hpp"
 
 namespace varslam::ros_image {
 namespace {
@@ -14,11 +15,6 @@ constexpr std::size_t kCompressedDepthHeader = 12;  // int32 format, float depth
 
 bool is_png(const std::uint8_t* d, std::size_t n) { return n >= 8 && std::memcmp(d, "\x89PNG\r\n\x1a\n", 8) == 0; }
 bool is_jpeg(const std::uint8_t* d, std::size_t n) { return n >= 3 && d[0] == 0xFF && d[1] == 0xD8 && d[2] == 0xFF; }
-
-cv::Mat imdecode(const std::uint8_t* d, std::size_t n, int flags) {
-  const cv::Mat buf(1, static_cast<int>(n), CV_8UC1, const_cast<std::uint8_t*>(d));
-  return cv::imdecode(buf, flags);
-}
 
 }  // namespace
 
@@ -87,7 +83,7 @@ cv::Mat decode_compressed_image(const std::string& format, const std::uint8_t* d
   if (!is_compressed_depth(format)) {
     if (!is_png(data, size) && !is_jpeg(data, size))
       throw InputError(where + ": compressed image (format '" + format + "') is not PNG or JPEG data");
-    cv::Mat bgr = imdecode(data, size, cv::IMREAD_COLOR);
+    cv::Mat bgr = decode_colour_image({data, size});
     if (bgr.empty()) throw InputError(where + ": cannot decode the compressed image (format '" + format + "')");
     return bgr;
   }
@@ -101,7 +97,7 @@ cv::Mat decode_compressed_image(const std::string& format, const std::uint8_t* d
     std::memcpy(&quant_b, data + 8, sizeof(float));
     offset = kCompressedDepthHeader;
   }
-  cv::Mat raw = imdecode(data + offset, size - offset, cv::IMREAD_UNCHANGED);
+  cv::Mat raw = decode_unchanged_image({data + offset, size - offset});
   if (raw.empty() || raw.type() != CV_16UC1)
     throw InputError(where + ": compressedDepth PNG (format '" + format + "') is not a 16-bit single-channel image");
   if (format.rfind("16UC1", 0) == 0 || format.rfind("mono16", 0) == 0) return raw;

@@ -1,0 +1,28 @@
+#pragma once
+// Decoding of the image files RGB-D datasets store, with the pixels cv::imdecode gives, in less time: a colour
+// JPEG straight into BGR order (OpenCV's own path decodes to RGB and then swaps every pixel) and a 16-bit
+// greyscale PNG inflated by libdeflate. Every other kind of file goes to cv::imdecode.
+#include <cstdint>
+#include <filesystem>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <span>
+#include <vector>
+
+namespace varslam {
+
+/// The bytes of `file`; std::nullopt when it cannot be opened or read.
+std::optional<std::vector<std::uint8_t>> read_file_bytes(const std::filesystem::path& file);
+
+/// cv::imdecode(bytes, cv::IMREAD_COLOR): a CV_8UC3 BGR image, or an empty Mat when the bytes are no image.
+cv::Mat decode_colour_image(std::span<const std::uint8_t> bytes);
+
+/// cv::imdecode(bytes, cv::IMREAD_UNCHANGED): the image as stored, or an empty Mat when the bytes are no image.
+cv::Mat decode_unchanged_image(std::span<const std::uint8_t> bytes);
+
+/// The fast paths on their own (for their tests): the image when `bytes` is the kind the path handles and decodes
+/// cleanly, std::nullopt for anything else (the callers above then ask cv::imdecode).
+std::optional<cv::Mat> decode_ycbcr_jpeg_to_bgr(std::span<const std::uint8_t> bytes);
+std::optional<cv::Mat> decode_grey16_png(std::span<const std::uint8_t> bytes);
+
+}  // namespace varslam
