@@ -122,16 +122,15 @@ class ListedRgbdDataset final : public Dataset {
     if (!exists) throw InputError(fmt::format("{}: listed image {} does not exist", e.where, path));
   }
 
-  // OpenCV picks a decoder by the file's content, whatever its name, and some it links abort on malformed input
-  // (its DICOM reader asserts; found by fuzzing): only PNG and JPEG files, the formats RGB-D datasets use, reach it.
-  // The file's bytes, once it is known to be a PNG or JPEG (what the decoders read).
+  // The file's bytes, once it is known to be a PNG or JPEG, the formats RGB-D datasets use. OpenCV picks a decoder
+  // by the file's content, whatever its name, and some it links abort on malformed input (its DICOM reader asserts;
+  // found by fuzzing), so nothing else reaches it.
   static std::vector<std::uint8_t> read_image_file(const ListEntry& e, const std::string& path) {
     std::optional<std::vector<std::uint8_t>> bytes = read_file_bytes(path);
     if (!bytes) throw InputError(fmt::format("{}: cannot read image {}: {}", e.where, path, describe_errno(errno)));
-    const std::span<const std::uint8_t> head(*bytes);
-    const bool png = head.size() >= 8 && std::memcmp(head.data(), "\x89PNG\r\n\x1a\n", 8) == 0;
-    const bool jpeg = head.size() >= 3 && head[0] == 0xFF && head[1] == 0xD8 && head[2] == 0xFF;
-    const bool dicom = head.size() >= 132 && std::memcmp(head.data() + 128, "DICM", 4) == 0;  // tried before PNG/JPEG
+    // The DICOM reader recognises "DICM" at byte 128: such a file is refused even with a PNG or JPEG signature.
+    const bool dicom = bytes->size() >= 132 && std::memcmp(bytes->data() + 128, "DICM", 4) == 0;
+    const bool png = is_png(*bytes), jpeg = is_jpeg(*bytes);
     if ((png || jpeg) && !dicom) return std::move(*bytes);
     throw InputError(fmt::format("{}: {} is not a PNG or JPEG image", e.where, path));
   }

@@ -4,6 +4,7 @@
 #include <turbojpeg.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <limits>
@@ -25,30 +26,57 @@ constexpr std::int64_t kMaxDecodedPixels = std::int64_t{1} << 26;
 
 // ---- JPEG ----
 
-// cv::imdecode turns an image by its EXIF orientation tag, so a JPEG that carries EXIF (or whose segments
-// before the scan cannot be walked) is left to it. Walks the marker segments up to the start of scan.
-bool jpeg_may_carry_exif(std::span<const std::uint8_t> b) {
+enum class JpegWalkEnd { StartOfScan, Stopped, Broken };
+
+// Calls visit(marker, payload) for each marker segment before the start of scan, skipping what libjpeg's marker
+// reader skips (stray bytes, fill bytes, stuffed zeros), so that it sees the segments OpenCV's decoder will see.
+// visit returns false to stop the walk.
+template <class Visit>
+JpegWalkEnd walk_jpeg_segments(std::span<const std::uint8_t> b, Visit visit) {
   std::size_t pos = 2;  // after SOI
-  while (pos + 4 <= b.size()) {
-    if (b[pos] != 0xFF) return true;
+  while (pos + 2 <= b.size()) {
     const std::uint8_t marker = b[pos + 1];
-    if (marker == 0xFF) {  // fill byte
+    if (b[pos] != 0xFF || marker == 0xFF || marker == 0x00) {
       ++pos;
       continue;
     }
-    if (marker == 0xDA) return false;  // start of scan: no EXIF before it
-    if (marker == 0x01 || (marker >= 0xD0 && marker <= 0xD7)) {  // markers without a length
+    if (marker == 0xDA) return JpegWalkEnd::StartOfScan;
+    if (marker == 0xD9) return JpegWalkEnd::Broken;  // end of image before any scan
+    if (marker == 0x01 || (marker >= 0xD0 && marker <= 0xD8)) {  // markers without a length
       pos += 2;
       continue;
     }
+    if (pos + 4 > b.size()) return JpegWalkEnd::Broken;
     const std::size_t length = read_be16(&b[pos + 2]);
-    if (length < 2 || pos + 2 + length > b.size()) return true;
-    if (marker == 0xE1 && length >= 8 && std::memcmp(&b[pos + 4], "Exif\0\0", 6) == 0) return true;
+    if (length < 2 || length > b.size() - pos - 2) return JpegWalkEnd::Broken;
+    if (!visit(marker, b.subspan(pos + 4, length - 2))) return JpegWalkEnd::Stopped;
     pos += 2 + length;
   }
-  return true;
+  return JpegWalkEnd::Broken;
 }
 
+// cv::imdecode reads EXIF from the first APP1 segment whatever its label, and turns the image by its orientation
+// tag: a JPEG with any APP1 segment (or whose segments cannot be walked to the scan) is left to it.
+bool jpeg_may_carry_exif(std::span<const std::uint8_t> b) {
+  bool app1 = false;
+  const JpegWalkEnd end = walk_jpeg_segments(b, [&](std::uint8_t marker, std::span<const std::uint8_t>) {
+    app1 = marker == 0xE1;
+    return !app1;
+  });
+  return app1 || end != JpegWalkEnd::StartOfScan;
+}
+
+// The size in the JPEG's frame header (SOF0-SOF15; C4, C8 and CC are other markers).
+std::optional<cv::Size> jpeg_declared_size(std::span<const std::uint8_t> b) {
+  std::optional<cv::Size> size;
+  walk_jpeg_segments(b, [&](std::uint8_t m, std::span<const std::uint8_t> payload) {
+    const bool frame_header = m >= 0xC0 && m <= 0xCF && m != 0xC4 && m != 0xC8 && m != 0xCC;
+    if (frame_header && payload.size() >= 5)  // precision, then height and width
+      size = cv::Size(static_cast<int>(read_be16(&payload[3])), static_cast<int>(read_be16(&payload[1])));
+    return !size;
+  });
+  return size;
+}
 
 struct TurboJpegDeleter {
   void operator()(void* handle) const { tjDestroy(handle); }
@@ -56,9 +84,20 @@ struct TurboJpegDeleter {
 
 // ---- PNG ----
 
-constexpr std::uint8_t kPngSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
-constexpr std::uint32_t kMaxPngSide = 1u << 14;  // larger images are left to OpenCV's own limits
-constexpr std::size_t kMaxDeflateRatio = 1032;    // the most a deflate stream can expand (258 bytes per 2 bits)
+constexpr std::size_t kMaxDeflateRatio = 1032;  // the most a deflate stream can expand (258 bytes per 2 bits)
+
+bool is_chunk_name(const std::uint8_t* type) {
+  return std::all_of(type, type + 4, [](std::uint8_t c) { return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z'); });
+}
+
+// The fewest bytes the pixel data of a PNG with this header can inflate to: each row's filter byte and its
+// pixels at the header's bit depth and colour type (a palette or unknown type counted at one channel).
+std::int64_t png_min_raw_bytes(std::span<const std::uint8_t> b) {
+  const std::int64_t width = read_be32(&b[16]), height = read_be32(&b[20]);
+  const int bit_depth = b[24], colour_type = b[25];
+  const int channels = colour_type == 2 ? 3 : colour_type == 4 ? 2 : colour_type == 6 ? 4 : 1;
+  return height * (1 + (width * bit_depth * channels + 7) / 8);
+}
 
 // A row of `n` bytes of a PNG with two bytes per pixel, unfiltered in place (PNG specification, "Filter
 // algorithms"); `prev` is the row above, already unfiltered (zeros above the first row). False for an unknown
@@ -102,16 +141,16 @@ struct DeflateDeleter {
   void operator()(libdeflate_decompressor* d) const { libdeflate_free_decompressor(d); }
 };
 
-// The concatenated IDAT data of a non-interlaced 16-bit greyscale PNG whose chunks all check out, and its size;
-// std::nullopt for any other kind, a damaged chunk, or a chunk whose meaning the fast path does not apply
-// (tRNS, or an unknown critical chunk).
 struct Grey16Png {
   std::uint32_t width = 0, height = 0;
   std::vector<std::uint8_t> compressed;
 };
 
+// The size and concatenated IDAT data of a non-interlaced 16-bit greyscale PNG whose chunks all check out;
+// std::nullopt for any other kind, a damaged chunk, or a chunk whose meaning the fast path does not apply
+// (tRNS, or an unknown critical chunk).
 std::optional<Grey16Png> parse_grey16_png(std::span<const std::uint8_t> b) {
-  if (b.size() < 8 || !std::equal(std::begin(kPngSignature), std::end(kPngSignature), b.begin())) return std::nullopt;
+  if (!is_png(b)) return std::nullopt;
   Grey16Png png;
   bool have_header = false, idat_seen = false, idat_ended = false;
   std::size_t pos = 8;
@@ -120,7 +159,8 @@ std::optional<Grey16Png> parse_grey16_png(std::span<const std::uint8_t> b) {
     if (length > b.size() - pos - 12) return std::nullopt;
     const std::uint8_t* type = &b[pos + 4];
     const std::uint8_t* data = type + 4;
-    if (libdeflate_crc32(0, type, length + 4) != read_be32(data + length)) return std::nullopt;
+    if (!is_chunk_name(type) || libdeflate_crc32(0, type, length + 4) != read_be32(data + length))
+      return std::nullopt;
     const std::string_view name(reinterpret_cast<const char*>(type), 4);
     pos += 12 + length;
     if (!have_header) {
@@ -128,7 +168,10 @@ std::optional<Grey16Png> parse_grey16_png(std::span<const std::uint8_t> b) {
       png.width = read_be32(data);
       png.height = read_be32(data + 4);
       const bool grey16 = data[8] == 16 && data[9] == 0 && data[10] == 0 && data[11] == 0 && data[12] == 0;
-      if (!grey16 || png.width == 0 || png.height == 0 || png.width > kMaxPngSide || png.height > kMaxPngSide)
+      // The sides are checked before their product, which then cannot overflow.
+      const std::int64_t width = png.width, height = png.height;
+      if (!grey16 || width == 0 || height == 0 || width > kMaxDecodedPixels || height > kMaxDecodedPixels ||
+          width * height > kMaxDecodedPixels)
         return std::nullopt;
       have_header = true;
     } else if (name == "IDAT") {
@@ -146,52 +189,64 @@ std::optional<Grey16Png> parse_grey16_png(std::span<const std::uint8_t> b) {
   return std::nullopt;  // no IEND
 }
 
-// The width and height a PNG's or JPEG's header declares; std::nullopt when the header cannot be found.
-std::optional<cv::Size> declared_size(std::span<const std::uint8_t> b) {
-  if (b.size() >= 24 && std::equal(std::begin(kPngSignature), std::end(kPngSignature), b.begin()))
-    return cv::Size(static_cast<int>(std::min<std::uint32_t>(read_be32(&b[16]), 1u << 30)),
-                    static_cast<int>(std::min<std::uint32_t>(read_be32(&b[20]), 1u << 30)));
-  if (b.size() < 4 || b[0] != 0xFF || b[1] != 0xD8) return std::nullopt;
-  for (std::size_t pos = 2; pos + 9 <= b.size();) {  // the JPEG's segments up to its frame header (SOFn)
-    if (b[pos] != 0xFF) return std::nullopt;
-    const std::uint8_t marker = b[pos + 1];
-    if (marker == 0xFF || marker == 0x01 || (marker >= 0xD0 && marker <= 0xD7)) {  // fill byte, no length
-      pos += marker == 0xFF ? 1 : 2;
-      continue;
-    }
-    const bool frame_header = marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC;
-    if (frame_header)  // precision, then height and width
-      return cv::Size(static_cast<int>(read_be16(&b[pos + 7])), static_cast<int>(read_be16(&b[pos + 5])));
-    pos += 2 + read_be16(&b[pos + 2]);
-  }
-  return std::nullopt;
+// The zlib stream inflated to exactly `size` bytes; std::nullopt when it holds anything else. A window smaller
+// than the data is left to zlib (through OpenCV), which enforces it where libdeflate does not.
+std::optional<std::vector<std::uint8_t>> inflate_exactly(const std::vector<std::uint8_t>& zlib, std::size_t size) {
+  // Deflate expands at most 1032 times: a header promising more than the data can hold is damaged, and must not
+  // make a small file allocate a large buffer.
+  if (zlib.size() < 2 || size / kMaxDeflateRatio > zlib.size()) return std::nullopt;
+  const int window_log2 = (zlib[0] >> 4) + 8;  // 15 (32 KB) is the most deflate's distances can reach anyway
+  if (window_log2 < 15 && size > std::size_t{1} << window_log2) return std::nullopt;
+  std::vector<std::uint8_t> raw(size);
+  const std::unique_ptr<libdeflate_decompressor, DeflateDeleter> inflater(libdeflate_alloc_decompressor());
+  std::size_t produced = 0;
+  if (!inflater ||
+      libdeflate_zlib_decompress(inflater.get(), zlib.data(), zlib.size(), raw.data(), size, &produced) !=
+          LIBDEFLATE_SUCCESS ||
+      produced != size)
+    return std::nullopt;
+  return raw;
 }
 
 // Whether OpenCV may be given the file: it allocates the image its header declares before reading any pixel, so
 // a damaged header of a few bytes could cost gigabytes. Refused: more pixels than any camera image has, or a PNG
-// whose smallest possible pixel data (one bit a pixel) is more than its bytes can inflate to.
+// whose smallest possible pixel data is more than its bytes can inflate to.
 bool plausible_size(std::span<const std::uint8_t> b) {
-  const std::optional<cv::Size> size = declared_size(b);
-  if (!size) return true;  // OpenCV finds no header either, and allocates nothing
-  const std::int64_t pixels = std::int64_t{size->width} * size->height;
-  if (pixels > kMaxDecodedPixels) return false;
-  const bool png = b[0] == kPngSignature[0];
-  const std::int64_t min_png_bytes = std::int64_t{size->height} * (1 + (std::int64_t{size->width} + 7) / 8);
-  return !png || min_png_bytes / std::int64_t{kMaxDeflateRatio} <= static_cast<std::int64_t>(b.size());
+  if (is_png(b)) {
+    if (b.size() < 26) return true;  // no header: OpenCV allocates nothing
+    const std::int64_t width = read_be32(&b[16]), height = read_be32(&b[20]);
+    return width <= kMaxDecodedPixels && height <= kMaxDecodedPixels && width * height <= kMaxDecodedPixels &&
+           png_min_raw_bytes(b) / std::int64_t{kMaxDeflateRatio} <= static_cast<std::int64_t>(b.size());
+  }
+  const std::optional<cv::Size> size = jpeg_declared_size(b);
+  return !size || std::int64_t{size->width} * size->height <= kMaxDecodedPixels;
 }
 
 cv::Mat opencv_decode(std::span<const std::uint8_t> bytes, int flags) {
-  if (bytes.empty() || bytes.size() > std::size_t{std::numeric_limits<int>::max()} || !plausible_size(bytes))
+  // Only PNG and JPEG: OpenCV's other decoders include one that aborts the process on damaged input (DICOM, which
+  // it recognises by "DICM" at byte 128 whatever the signature).
+  const bool dicom = bytes.size() >= 132 && std::memcmp(bytes.data() + 128, "DICM", 4) == 0;
+  if (!(is_png(bytes) || is_jpeg(bytes)) || dicom || bytes.size() > std::size_t{std::numeric_limits<int>::max()} ||
+      !plausible_size(bytes))
     return {};
   const cv::Mat wrapped(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<std::uint8_t*>(bytes.data()));
   try {
     return cv::imdecode(wrapped, flags);  // reads only
-  } catch (const cv::Exception&) {
+  } catch (const std::exception&) {
     return {};  // OpenCV throws for some damaged headers (a size over its pixel limit): no image, as for others
   }
 }
 
 }  // namespace
+
+bool is_png(std::span<const std::uint8_t> bytes) {
+  static constexpr std::uint8_t kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+  return bytes.size() >= 8 && std::equal(std::begin(kSignature), std::end(kSignature), bytes.begin());
+}
+
+bool is_jpeg(std::span<const std::uint8_t> bytes) {
+  return bytes.size() >= 3 && bytes[0] == 0xFF && bytes[1] == 0xD8 && bytes[2] == 0xFF;
+}
 
 std::optional<std::vector<std::uint8_t>> read_file_bytes(const std::filesystem::path& file) {
   std::ifstream in(file, std::ios::binary | std::ios::ate);
@@ -205,7 +260,7 @@ std::optional<std::vector<std::uint8_t>> read_file_bytes(const std::filesystem::
 }
 
 std::optional<cv::Mat> decode_ycbcr_jpeg_to_bgr(std::span<const std::uint8_t> bytes) {
-  if (bytes.size() < 4 || bytes[0] != 0xFF || bytes[1] != 0xD8 || jpeg_may_carry_exif(bytes)) return std::nullopt;
+  if (!is_jpeg(bytes) || jpeg_may_carry_exif(bytes)) return std::nullopt;
   const std::unique_ptr<void, TurboJpegDeleter> handle(tjInitDecompress());
   if (!handle) return std::nullopt;
   int width = 0, height = 0, subsampling = 0, colourspace = 0;
@@ -216,9 +271,10 @@ std::optional<cv::Mat> decode_ycbcr_jpeg_to_bgr(std::span<const std::uint8_t> by
       std::int64_t{width} * height > kMaxDecodedPixels)  // a damaged header must not allocate gigabytes here
     return std::nullopt;
   cv::Mat bgr(height, width, CV_8UC3);
-  // Flags 0: the accurate inverse DCT and smooth chroma upsampling, libjpeg's defaults that OpenCV decodes with.
-  // Any warning (a damaged stream) is left to OpenCV, which decides what such a file gives.
-  if (tjDecompress2(handle.get(), data, size, bgr.data, width, static_cast<int>(bgr.step[0]), height, TJPF_BGR, 0) != 0)
+  // The accurate inverse DCT and smooth chroma upsampling are TurboJPEG's defaults, and libjpeg's that OpenCV
+  // decodes with. At the first warning (a damaged stream) the file is left to OpenCV, which decides what it gives.
+  if (tjDecompress2(handle.get(), data, size, bgr.data, width, static_cast<int>(bgr.step[0]), height, TJPF_BGR,
+                    TJFLAG_STOPONWARNING) != 0)
     return std::nullopt;
   return bgr;
 }
@@ -227,23 +283,14 @@ std::optional<cv::Mat> decode_grey16_png(std::span<const std::uint8_t> bytes) {
   const std::optional<Grey16Png> png = parse_grey16_png(bytes);
   if (!png) return std::nullopt;
   const std::size_t row_bytes = std::size_t{png->width} * 2;
-  const std::size_t raw_size = std::size_t{png->height} * (row_bytes + 1);  // each row starts with its filter type
-  // Deflate expands at most 1032 times: a header promising more than the data can hold is damaged, and must not
-  // make a small file allocate a large buffer.
-  if (raw_size / kMaxDeflateRatio > png->compressed.size()) return std::nullopt;
-  std::vector<std::uint8_t> raw(raw_size);
-  const std::unique_ptr<libdeflate_decompressor, DeflateDeleter> inflater(libdeflate_alloc_decompressor());
-  if (!inflater) return std::nullopt;
-  std::size_t produced = 0;
-  if (libdeflate_zlib_decompress(inflater.get(), png->compressed.data(), png->compressed.size(), raw.data(),
-                                 raw_size, &produced) != LIBDEFLATE_SUCCESS ||
-      produced != raw_size)
-    return std::nullopt;
+  // Each row starts with its filter type.
+  std::optional<std::vector<std::uint8_t>> raw = inflate_exactly(png->compressed, png->height * (row_bytes + 1));
+  if (!raw) return std::nullopt;
   cv::Mat image(static_cast<int>(png->height), static_cast<int>(png->width), CV_16UC1);
   const std::vector<std::uint8_t> zero_row(row_bytes, 0);
   const std::uint8_t* prev = zero_row.data();
   for (int y = 0; y < image.rows; ++y) {
-    std::uint8_t* row = raw.data() + std::size_t(y) * (row_bytes + 1);
+    std::uint8_t* row = raw->data() + std::size_t(y) * (row_bytes + 1);
     if (!unfilter_row(row[0], row + 1, prev, row_bytes)) return std::nullopt;
     prev = row + 1;
     auto* out = image.ptr<std::uint16_t>(y);
@@ -253,12 +300,18 @@ std::optional<cv::Mat> decode_grey16_png(std::span<const std::uint8_t> bytes) {
 }
 
 cv::Mat decode_colour_image(std::span<const std::uint8_t> bytes) {
-  if (std::optional<cv::Mat> bgr = decode_ycbcr_jpeg_to_bgr(bytes)) return *bgr;
+  try {
+    if (std::optional<cv::Mat> bgr = decode_ycbcr_jpeg_to_bgr(bytes)) return *bgr;
+  } catch (const std::exception&) {  // out of memory for a large image: OpenCV may still manage, or say no
+  }
   return opencv_decode(bytes, cv::IMREAD_COLOR);
 }
 
 cv::Mat decode_unchanged_image(std::span<const std::uint8_t> bytes) {
-  if (std::optional<cv::Mat> grey16 = decode_grey16_png(bytes)) return *grey16;
+  try {
+    if (std::optional<cv::Mat> grey16 = decode_grey16_png(bytes)) return *grey16;
+  } catch (const std::exception&) {  // out of memory for a large image: OpenCV may still manage, or say no
+  }
   return opencv_decode(bytes, cv::IMREAD_UNCHANGED);
 }
 

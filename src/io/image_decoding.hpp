@@ -1,7 +1,8 @@
 #pragma once
 // Decoding of the image files RGB-D datasets store, with the pixels cv::imdecode gives, in less time: a colour
 // JPEG straight into BGR order (OpenCV's own path decodes to RGB and then swaps every pixel) and a 16-bit
-// greyscale PNG inflated by libdeflate. Every other kind of file goes to cv::imdecode.
+// greyscale PNG inflated by libdeflate. Other PNGs and JPEGs go to cv::imdecode, once their headers declare a
+// plausible size; anything else is no image. Nothing here throws.
 #include <cstdint>
 #include <filesystem>
 #include <opencv2/core.hpp>
@@ -11,10 +12,15 @@
 
 namespace varslam {
 
+/// Whether the bytes start with the PNG signature, or with a JPEG's start-of-image marker and a segment.
+bool is_png(std::span<const std::uint8_t> bytes);
+bool is_jpeg(std::span<const std::uint8_t> bytes);
+
 /// The bytes of `file`; std::nullopt when it cannot be opened or read.
 std::optional<std::vector<std::uint8_t>> read_file_bytes(const std::filesystem::path& file);
 
-/// cv::imdecode(bytes, cv::IMREAD_COLOR): a CV_8UC3 BGR image, or an empty Mat when the bytes are no image.
+/// cv::imdecode(bytes, cv::IMREAD_COLOR): a CV_8UC3 BGR image, or an empty Mat when the bytes are no image (or a
+/// damaged one: the fast paths may read a stream zlib would refuse, e.g. one with reserved deflate codes).
 cv::Mat decode_colour_image(std::span<const std::uint8_t> bytes);
 
 /// cv::imdecode(bytes, cv::IMREAD_UNCHANGED): the image as stored, or an empty Mat when the bytes are no image.

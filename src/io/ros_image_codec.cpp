@@ -13,8 +13,8 @@ namespace {
 
 constexpr std::size_t kCompressedDepthHeader = 12;  // int32 format, float depthQuantA, float depthQuantB
 
-bool is_png(const std::uint8_t* d, std::size_t n) { return n >= 8 && std::memcmp(d, "\x89PNG\r\n\x1a\n", 8) == 0; }
-bool is_jpeg(const std::uint8_t* d, std::size_t n) { return n >= 3 && d[0] == 0xFF && d[1] == 0xD8 && d[2] == 0xFF; }
+bool is_png(const std::uint8_t* d, std::size_t n) { return varslam::is_png({d, n}); }
+bool is_jpeg(const std::uint8_t* d, std::size_t n) { return varslam::is_jpeg({d, n}); }
 
 }  // namespace
 
