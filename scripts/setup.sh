@@ -2,7 +2,8 @@
 # Installs the Debian packages varslam builds and tests with. Idempotent: skips apt when all are present.
 set -euo pipefail
 PKGS=(build-essential cmake pkg-config ccache libopencv-dev libeigen3-dev libceres-dev libyaml-cpp-dev
-      libcli11-dev libfmt-dev libspdlog-dev nlohmann-json3-dev zlib1g-dev libturbojpeg0-dev libdeflate-dev libgtest-dev libgmock-dev libbenchmark-dev
+      libcli11-dev libfmt-dev libspdlog-dev nlohmann-json3-dev zlib1g-dev libturbojpeg0-dev libdeflate-dev
+      libgtest-dev libgmock-dev libbenchmark-dev
       opencv-doc libcpp-httplib-dev liboctomap-dev chromium fonts-dejavu-core
       # ROS 1 (Debian's Noetic-era packages): .bag input and the ROS node. Debian's rosbag/bag.h needs pluginlib's
       # headers and the ROS 2 helpers they include; ros-core is roscore, python3-rosbag is `rosbag play/reindex`.

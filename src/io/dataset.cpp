@@ -5,9 +5,7 @@
 
 #include <atomic>
 #include <cerrno>
-#include <cstring>
 #include <optional>
-#include <span>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 #include <utility>
@@ -122,16 +120,12 @@ class ListedRgbdDataset final : public Dataset {
     if (!exists) throw InputError(fmt::format("{}: listed image {} does not exist", e.where, path));
   }
 
-  // The file's bytes, once it is known to be a PNG or JPEG, the formats RGB-D datasets use. OpenCV picks a decoder
-  // by the file's content, whatever its name, and some it links abort on malformed input (its DICOM reader asserts;
-  // found by fuzzing), so nothing else reaches it.
+  // The file's bytes, once it is known to be a PNG or JPEG, the formats RGB-D datasets use (the decoders would give
+  // no image for anything else; this names the problem).
   static std::vector<std::uint8_t> read_image_file(const ListEntry& e, const std::string& path) {
     std::optional<std::vector<std::uint8_t>> bytes = read_file_bytes(path);
     if (!bytes) throw InputError(fmt::format("{}: cannot read image {}: {}", e.where, path, describe_errno(errno)));
-    // The DICOM reader recognises "DICM" at byte 128: such a file is refused even with a PNG or JPEG signature.
-    const bool dicom = bytes->size() >= 132 && std::memcmp(bytes->data() + 128, "DICM", 4) == 0;
-    const bool png = is_png(*bytes), jpeg = is_jpeg(*bytes);
-    if ((png || jpeg) && !dicom) return std::move(*bytes);
+    if (is_png_or_jpeg_file(*bytes)) return std::move(*bytes);
     throw InputError(fmt::format("{}: {} is not a PNG or JPEG image", e.where, path));
   }
 

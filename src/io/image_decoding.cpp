@@ -223,10 +223,7 @@ bool plausible_size(std::span<const std::uint8_t> b) {
 }
 
 cv::Mat opencv_decode(std::span<const std::uint8_t> bytes, int flags) {
-  // Only PNG and JPEG: OpenCV's other decoders include one that aborts the process on damaged input (DICOM, which
-  // it recognises by "DICM" at byte 128 whatever the signature).
-  const bool dicom = bytes.size() >= 132 && std::memcmp(bytes.data() + 128, "DICM", 4) == 0;
-  if (!(is_png(bytes) || is_jpeg(bytes)) || dicom || bytes.size() > std::size_t{std::numeric_limits<int>::max()} ||
+  if (!is_png_or_jpeg_file(bytes) || bytes.size() > std::size_t{std::numeric_limits<int>::max()} ||
       !plausible_size(bytes))
     return {};
   const cv::Mat wrapped(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<std::uint8_t*>(bytes.data()));
@@ -246,6 +243,11 @@ bool is_png(std::span<const std::uint8_t> bytes) {
 
 bool is_jpeg(std::span<const std::uint8_t> bytes) {
   return bytes.size() >= 3 && bytes[0] == 0xFF && bytes[1] == 0xD8 && bytes[2] == 0xFF;
+}
+
+bool is_png_or_jpeg_file(std::span<const std::uint8_t> bytes) {
+  const bool dicom = bytes.size() >= 132 && std::memcmp(bytes.data() + 128, "DICM", 4) == 0;
+  return (is_png(bytes) || is_jpeg(bytes)) && !dicom;
 }
 
 std::optional<std::vector<std::uint8_t>> read_file_bytes(const std::filesystem::path& file) {

@@ -16,6 +16,10 @@ namespace varslam {
 bool is_png(std::span<const std::uint8_t> bytes);
 bool is_jpeg(std::span<const std::uint8_t> bytes);
 
+/// A PNG or JPEG that OpenCV will read as one: OpenCV also tries its DICOM reader, which recognises "DICM" at byte
+/// 128 whatever the signature and aborts the process on a damaged file, so such bytes are not one.
+bool is_png_or_jpeg_file(std::span<const std::uint8_t> bytes);
+
 /// The bytes of `file`; std::nullopt when it cannot be opened or read.
 std::optional<std::vector<std::uint8_t>> read_file_bytes(const std::filesystem::path& file);
 

@@ -13,9 +13,6 @@ namespace {
 
 constexpr std::size_t kCompressedDepthHeader = 12;  // int32 format, float depthQuantA, float depthQuantB
 
-bool is_png(const std::uint8_t* d, std::size_t n) { return varslam::is_png({d, n}); }
-bool is_jpeg(const std::uint8_t* d, std::size_t n) { return varslam::is_jpeg({d, n}); }
-
 }  // namespace
 
 int raw_bytes_per_pixel(const std::string& e) {
@@ -81,7 +78,7 @@ bool is_compressed_depth(const std::string& format) { return format.find("compre
 cv::Mat decode_compressed_image(const std::string& format, const std::uint8_t* data, std::size_t size,
                                 const std::string& where) {
   if (!is_compressed_depth(format)) {
-    if (!is_png(data, size) && !is_jpeg(data, size))
+    if (!is_png({data, size}) && !is_jpeg({data, size}))
       throw InputError(where + ": compressed image (format '" + format + "') is not PNG or JPEG data");
     cv::Mat bgr = decode_colour_image({data, size});
     if (bgr.empty()) throw InputError(where + ": cannot decode the compressed image (format '" + format + "')");
@@ -90,8 +87,8 @@ cv::Mat decode_compressed_image(const std::string& format, const std::uint8_t* d
   // image_transport's compressedDepth: a 12-byte header, then a PNG (older writers: the PNG alone).
   std::size_t offset = 0;
   float quant_a = 0, quant_b = 0;
-  if (!is_png(data, size)) {
-    if (size < kCompressedDepthHeader || !is_png(data + kCompressedDepthHeader, size - kCompressedDepthHeader))
+  if (!is_png({data, size})) {
+    if (size < kCompressedDepthHeader || !is_png({data + kCompressedDepthHeader, size - kCompressedDepthHeader}))
       throw InputError(where + ": compressedDepth data (format '" + format + "') holds no PNG");
     std::memcpy(&quant_a, data + 4, sizeof(float));
     std::memcpy(&quant_b, data + 8, sizeof(float));
