@@ -2,8 +2,9 @@
 # How far a real sequence's ATE moves under changes that should not matter, so a change is judged against that
 # spread (issue #33): the four benchmark configurations, each from the first frame and from two later starts, and
 # with the ORB feature count 10 % lower and higher. Deterministic mode; one run per cell.
-#   [FEATURES=1000] bench/kitchen_spread.sh [DATASET=../shared/realdata/7scenes_redkitchen] [OUT=/tmp/varslam_kitchen_spread]
+#   [FEATURES=1000] [RESUME=1] bench/kitchen_spread.sh [DATASET=../shared/realdata/7scenes_redkitchen] [OUT=/tmp/varslam_kitchen_spread]
 #     [-- extra run options]
+# RESUME=1 keeps the cells of OUT that have a metrics.json (a sweep that was cut off goes on where it stopped).
 # Writes OUT/spread.md (a table: ATE per configuration and variant, and each configuration's spread) and prints it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -36,6 +37,7 @@ total=$(( ${#configs[@]} * ${#variants[@]} )); n=0
 for c in "${configs[@]}"; do
   for v in "${variants[@]}"; do
     n=$((n + 1)); dir="$out/$c/$v"; mkdir -p "$out/$c"
+    if [ -n "${RESUME:-}" ] && [ -f "$dir/metrics.json" ]; then echo "[$n/$total] $c $v: done before" >&2; continue; fi
     echo "[$n/$total] $c $v" >&2
     # shellcheck disable=SC2086  # the option strings are word lists
     "$bin" run -d "$data" --out "$dir" -q ${config[$c]} ${variant[$v]} "$@" > "$dir.log" 2>&1 ||

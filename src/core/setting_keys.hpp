@@ -99,7 +99,8 @@ inline constexpr KeySpec kKeys[] = {
     detail::positive("depth.th_depth", 40.0, 1e4, "close/far threshold in baselines (ORB-SLAM's ThDepth): points nearer than th_depth * baseline are close", "Stereo.ThDepth|ThDepth"),
     detail::real("depth.edge_ratio", 0.1, 0.0, 1.0, "keypoints on depth discontinuities keep no depth (colour and depth of real sensors are misregistered there); 0 = off"),
     detail::real("depth.disparity_weight", 10.0, 0.0, 1e4, "depth term of pose optimisation and BA: disparity bf/z with sigma 1/weight pixels; 0 = ORB-SLAM3's virtual-stereo residual"),
-    detail::choice("depth.registration", "auto", "auto|off", "auto: check on 10 frames whether depth is registered to colour and warp it into the colour camera when it clearly is not"),
+    detail::choice("depth.registration", "auto", "auto|off", "auto: check on 20 frames spread over the sequence whether depth is registered to colour and warp it into the colour camera when it clearly is not"),
+    detail::real("depth.registration_max_baseline_m", 0.06, 0.0, 0.2, "auto registration: the baseline between depth and colour camera searched, +- metres along the image rows; 0 = zoom and shift only"),
     detail::optional_real("depth.camera_fx", 0.0, 1e5, "depth camera focal length x: when given (> 0), depth comes from this separate camera and is warped into the colour camera; 0 = none"),
     detail::optional_real("depth.camera_fy", 0.0, 1e5, "depth camera focal length y (default: depth.camera_fx)", "("),
     detail::optional_real("depth.camera_cx", -1e5, 1e5, "depth camera principal point x (default: camera.cx)"),
@@ -240,13 +241,16 @@ inline constexpr KeySpec kKeys[] = {
     detail::integer("dense.mover_margin_px", 3, 0, 100, "the mover mask grows by this many pixels (the mixed depths at a mover's outline)"),
     detail::positive("dense.reintegrate_m", 0.01, 10.0, "real-time mode: a keyframe whose pose moved this far (m) since it was fused is fused again"),
     detail::positive("dense.reintegrate_deg", 0.5, 180.0, "... or turned this much (degrees)"),
+
+    // eval: how a run's trajectory is compared with the dataset's ground truth.
+    detail::choice("eval.groundtruth_camera", "colour", "colour|depth", "the camera the ground truth poses are of: colour, or depth (a separate depth camera, e.g. 7-Scenes' KinectFusion poses): the estimate is then moved by the depth camera's offset before ATE/RPE (registered depth: the same camera)"),
 };
 // clang-format on
 
 /// Sections of the registry (the part of a key before the dot), in table order.
 inline constexpr std::string_view kSections[] = {"camera",   "depth", "orb",            "features", "tracking",
                                                  "mapping",  "loop",  "relocalization", "semantic",
-                                                 "dense"};
+                                                 "dense",    "eval"};
 
 /// ORB-SLAM3 / ORB-SLAM2 keys that varslam reads nothing from: accepted in settings files, never an error.
 /// An entry ending in '.' covers every key with that prefix.

@@ -11,6 +11,7 @@ namespace {
 
 struct FrameEdges {
   std::vector<cv::Point2f> points;  // depth-edge pixels
+  std::vector<float> inverse_depth;  // 1 / z of each, 1/m
   cv::Mat gradient;                 // CV_32F colour gradient magnitude, mean 1
 };
 
@@ -28,40 +29,90 @@ cv::Mat normalised_gradient(const cv::Mat& gray) {
 
 struct Mapping {
   double scale, du, dv;
+  double tx = 0.0;  // the depth camera's x in the colour frame (m): a parallax of colour fx * tx / z pixels
 };
+
+// Nearest pixel index of a coordinate, -1 when it rounds below 0 (no library call: this runs ~10^8 times).
+int nearest_index(double x) { return x < -0.5 ? -1 : static_cast<int>(x + 0.5); }
 
 // Over every `stride`-th edge point.
 double mean_gradient(const std::vector<FrameEdges>& frames, const PinholeCamera& d, const Mapping& m,
                      std::size_t stride = 1) {
+  const double parallax_per_inverse_depth = m.scale * d.fx * m.tx;
   double sum = 0.0;
   long n = 0;
   for (const FrameEdges& f : frames) {
     const cv::Mat& g = f.gradient;
     for (std::size_t i = 0; i < f.points.size(); i += stride) {
       const cv::Point2f& p = f.points[i];
-      const int u = static_cast<int>(std::lround(m.scale * (p.x - d.cx) + d.cx + m.du));
-      const int v = static_cast<int>(std::lround(m.scale * (p.y - d.cy) + d.cy + m.dv));
+      const double parallax = parallax_per_inverse_depth * f.inverse_depth[i];
+      const int u = nearest_index(m.scale * (p.x - d.cx) + d.cx + m.du + parallax);
+      const int v = nearest_index(m.scale * (p.y - d.cy) + d.cy + m.dv);
       if (u < 0 || v < 0 || u >= g.cols || v >= g.rows) continue;
-      sum += g.at<float>(v, u);
+      sum += g.ptr<float>(v)[u];
       ++n;
     }
   }
   return n > 0 ? sum / static_cast<double>(n) : 0.0;
 }
 
-// Best mapping over a grid of scales and shifts centred on `c`.
-Mapping grid_search(const std::vector<FrameEdges>& frames, const PinholeCamera& d, const Mapping& c, int scale_steps,
-                    double scale_step, int shift_steps, double shift_step, std::size_t stride, double& best_score) {
+struct Grid {
+  int scale_steps;
+  double scale_step;
+  int shift_steps;
+  double shift_step;
+};
+
+// Best mapping over a grid of scales and shifts centred on `c` (its baseline kept).
+Mapping grid_search(const std::vector<FrameEdges>& frames, const PinholeCamera& d, const Mapping& c, const Grid& g,
+                    std::size_t stride, double& best_score) {
   Mapping best = c;
   best_score = -1.0;
-  for (int i = -scale_steps; i <= scale_steps; ++i)
-    for (int j = -shift_steps; j <= shift_steps; ++j)
-      for (int k = -shift_steps; k <= shift_steps; ++k) {
-        const Mapping m{c.scale + i * scale_step, c.du + j * shift_step, c.dv + k * shift_step};
+  for (int i = -g.scale_steps; i <= g.scale_steps; ++i)
+    for (int j = -g.shift_steps; j <= g.shift_steps; ++j)
+      for (int k = -g.shift_steps; k <= g.shift_steps; ++k) {
+        const Mapping m{c.scale + i * g.scale_step, c.du + j * g.shift_step, c.dv + k * g.shift_step, c.tx};
         const double s = mean_gradient(frames, d, m, stride);
         if (s > best_score) best_score = s, best = m;
       }
   return best;
+}
+
+double mean_inverse_depth(const std::vector<FrameEdges>& frames) {
+  double sum = 0.0;
+  std::size_t n = 0;
+  for (const FrameEdges& f : frames)
+    for (const float w : f.inverse_depth) sum += w, ++n;
+  return n > 0 ? sum / static_cast<double>(n) : 0.0;
+}
+
+// The baseline shifts near edges more than far ones. A shift alone fits it at one depth; sweeping the baseline with
+// the shift moved to keep the mean edge in place, then refining around the best, fits it at every depth.
+Mapping baseline_search(const std::vector<FrameEdges>& frames, const PinholeCamera& d, const Mapping& no_baseline,
+                        const ColourRegistrationSearch& search, std::size_t coarse_stride, double& best_score) {
+  const double w = mean_inverse_depth(frames);
+  const int steps = static_cast<int>(std::ceil(search.max_baseline_m / search.baseline_step_m));
+  Mapping best = no_baseline;
+  best_score = -1.0;
+  for (int i = -steps; i <= steps; ++i) {
+    Mapping c = no_baseline;
+    c.tx = i * search.baseline_step_m;
+    c.du -= c.scale * d.fx * c.tx * w;
+    double s = 0.0;
+    const Mapping m = grid_search(frames, d, c, {1, 0.0025, 2, 1.0}, coarse_stride, s);
+    if (s > best_score) best_score = s, best = m;
+  }
+  Mapping fine = best;
+  best_score = -1.0;
+  for (const double half_steps : {-1.0, 0.0, 1.0}) {
+    Mapping c = best;
+    c.tx += 0.5 * half_steps * search.baseline_step_m;
+    c.du -= c.scale * d.fx * (c.tx - best.tx) * w;
+    double s = 0.0;
+    const Mapping m = grid_search(frames, d, c, {2, 0.00125, 2, 0.5}, 1, s);
+    if (s > best_score) best_score = s, fine = m;
+  }
+  return fine;
 }
 
 }  // namespace
@@ -107,7 +158,10 @@ ColourRegistration estimate_colour_registration(const std::vector<cv::Mat>& gray
     if (edges.empty()) continue;
     FrameEdges f;
     const std::size_t stride = std::max<std::size_t>(1, edges.size() / static_cast<std::size_t>(search.points_per_frame));
-    for (std::size_t k = 0; k < edges.size(); k += stride) f.points.emplace_back(edges[k]);
+    for (std::size_t k = 0; k < edges.size(); k += stride) {
+      f.points.emplace_back(edges[k]);
+      f.inverse_depth.push_back(1.0f / depths_m[i].at<float>(edges[k]));
+    }
     f.gradient = normalised_gradient(grays[i]);
     r.edge_points += static_cast<int>(f.points.size());
     frames.push_back(std::move(f));
@@ -116,17 +170,24 @@ ColourRegistration estimate_colour_registration(const std::vector<cv::Mat>& gray
   if (frames.empty()) return r;
 
   r.identity_score = mean_gradient(frames, depth_camera, {1.0, 0.0, 0.0});
-  // Coarse (1 % of scale, 2 px, a quarter of the points: 3549 mappings), then fine (0.25 %, 1 px, all points)
-  // around the best.
+  // Coarse (1 % of scale, 2 px, ~5000 points: 3549 mappings), then fine (0.25 %, 1 px, all points) around the best.
+  const std::size_t coarse_stride = std::max<std::size_t>(1, static_cast<std::size_t>(r.edge_points) / 5000);
   const double mid = 0.5 * (search.min_scale + search.max_scale);
   const int coarse_scales = static_cast<int>(std::ceil((search.max_scale - search.min_scale) / 0.02));
   double score = 0.0;
-  Mapping best = grid_search(frames, depth_camera, {mid, 0.0, 0.0}, coarse_scales, 0.01,
-                             search.max_shift_px / 2, 2.0, 4, score);
-  best = grid_search(frames, depth_camera, best, 6, 0.0025, 2, 1.0, 1, score);
+  Mapping best = grid_search(frames, depth_camera, {mid, 0.0, 0.0}, {coarse_scales, 0.01, search.max_shift_px / 2, 2.0},
+                             coarse_stride, score);
+  best = grid_search(frames, depth_camera, best, {6, 0.0025, 2, 1.0}, 1, score);
+  if (search.max_baseline_m > 0.0) {
+    double with_baseline_score = 0.0;
+    const Mapping with_baseline =
+        baseline_search(frames, depth_camera, best, search, coarse_stride, with_baseline_score);
+    if (with_baseline_score > score) best = with_baseline, score = with_baseline_score;
+  }
   r.scale = best.scale;
   r.du = best.du;
   r.dv = best.dv;
+  r.baseline_x = best.tx;
   r.score = score;
   // How far the mapping moves the farthest image corner from where identity puts it.
   double change = 0.0;

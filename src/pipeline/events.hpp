@@ -85,6 +85,7 @@ struct DepthRegistrationEvent {
   std::string mode;  // "off", "settings" (depth.camera_* given), "auto"
   bool found = false;  // auto: depth was found unregistered and is warped into the colour camera
   double scale = 1, du = 0, dv = 0, score = 0, identity_score = 0, ms = 0;
+  double baseline_x = 0;  // the depth camera's origin in the colour frame along x (m)
   int frames = 0;
   std::optional<PinholeCamera> colour_camera;  // the colour camera estimated (found)
 };

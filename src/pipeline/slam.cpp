@@ -22,8 +22,9 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 // Raw depth from a separate depth camera (7-Scenes, raw Kinect v1) misfits the colour edges; the settings'
-// intrinsics then describe the depth camera. When a zoom and shift clearly beats identity on the sample frames,
-// depth is warped into the colour camera it implies. Registered data (TUM, Bonn, synthetic) comes out as identity.
+// intrinsics then describe the depth camera. When a zoom, shift and baseline clearly beat identity on the sample
+// frames, depth is warped into the colour camera they imply. Registered data (TUM, Bonn, synthetic) comes out as
+// identity.
 DepthRegistrationEvent register_depth_if_needed(std::span<const RgbdFrame> samples, Settings& settings,
                                                 slam::SlamConfig& cfg) {
   DepthRegistrationEvent ev;
@@ -43,11 +44,14 @@ DepthRegistrationEvent register_depth_if_needed(std::span<const RgbdFrame> sampl
     grays.push_back(f.gray);
     depths.push_back(f.depth);
   }
-  const ColourRegistration reg = estimate_colour_registration(grays, depths, settings.camera);
+  ColourRegistrationSearch search;
+  search.max_baseline_m = cfg.tracking.registration_max_baseline_m;
+  const ColourRegistration reg = estimate_colour_registration(grays, depths, settings.camera, search);
   ev.found = reg.found;
   ev.scale = reg.scale;
   ev.du = reg.du;
   ev.dv = reg.dv;
+  ev.baseline_x = reg.baseline_x;
   ev.score = reg.score;
   ev.identity_score = reg.identity_score;
   ev.frames = reg.frames;
@@ -55,12 +59,15 @@ DepthRegistrationEvent register_depth_if_needed(std::span<const RgbdFrame> sampl
   if (reg.found) {
     DepthCameraRig rig;
     rig.depth = settings.camera;
+    rig.t_colour_depth = {reg.baseline_x, 0.0, 0.0};
     settings.camera = reg.colour_camera(rig.depth);
     cfg.tracking.depth_rig = rig;
     ev.colour_camera = settings.camera;
     spdlog::info("depth is not registered to colour (edge fit {:.2f} against {:.2f} as given): colour camera fx {:.1f} "
-                 "cx {:.1f} cy {:.1f}, depth warped into it (depth.registration: off to keep the images as they are)",
-                 reg.score, reg.identity_score, settings.camera.fx, settings.camera.cx, settings.camera.cy);
+                 "cx {:.1f} cy {:.1f}, depth camera {:.1f} cm beside it, depth warped into it "
+                 "(depth.registration: off to keep the images as they are)",
+                 reg.score, reg.identity_score, settings.camera.fx, settings.camera.cx, settings.camera.cy,
+                 100.0 * reg.baseline_x);
   }
   return ev;
 }

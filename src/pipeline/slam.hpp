@@ -101,6 +101,9 @@ class Pipeline {
                              const std::optional<Eigen::Isometry3d>& groundtruth_alignment = std::nullopt);
   /// The loaded map's alignment to ground truth, when it has one.
   const std::optional<Eigen::Isometry3d>& loaded_map_alignment() const { return loaded_alignment_; }
+  /// The separate depth camera depth is warped from (given in the settings or found on the first frames); nullopt
+  /// when depth is registered to colour.
+  const std::optional<DepthCameraRig>& depth_rig() const { return cfg_.tracking.depth_rig; }
 
   /// Tracks one frame. `bgr`: CV_8UC3 (or CV_8UC1 gray); `depth`: CV_16UC1 raw (divided by depth.factor) or
   /// CV_32FC1 metres, 0 = no depth; both of the camera's size. `boxes`: the people in this image from the caller's

@@ -27,9 +27,10 @@ namespace varslam::run {
 namespace {
 using Clock = std::chrono::steady_clock;
 
-// Up to 10 frames spread over the first 10 s: what depth registration decides on.
+// Up to 20 frames spread over the whole run: what depth registration decides on. Views of different depths make
+// the baseline between a separate depth camera and the colour camera observable.
 std::vector<RgbdFrame> registration_samples(const Dataset& ds, std::size_t first, std::size_t count) {
-  const std::size_t span = std::min<std::size_t>(count, 300), n = std::min<std::size_t>(span, 10);
+  const std::size_t span = count, n = std::min<std::size_t>(span, 20);
   std::vector<RgbdFrame> samples;
   for (std::size_t k = 0; k < n; ++k) {
     try {
@@ -192,6 +193,28 @@ nlohmann::json write_dense_map(dense::DenseMapper& d, const std::filesystem::pat
           {"free_voxels", occ.size() - occupied}};
 }
 
+// Where the ground truth's camera sits in the colour camera's frame: a separate depth camera's origin when the
+// settings say the ground truth tracks it (eval.groundtruth_camera: depth), else nothing.
+std::optional<Eigen::Vector3d> groundtruth_camera_offset(const Settings& settings, const Pipeline& slam) {
+  if (setting<std::string>(settings, "eval.groundtruth_camera") != "depth") return std::nullopt;
+  if (!slam.depth_rig()) {
+    spdlog::info("eval.groundtruth_camera: depth, but depth is registered to colour: one camera, nothing to move");
+    return std::nullopt;
+  }
+  const Eigen::Vector3d t = slam.depth_rig()->t_colour_depth;
+  spdlog::info("ATE and RPE of the depth camera ({:.1f}, {:.1f}, {:.1f}) cm from the colour camera "
+               "(eval.groundtruth_camera: depth)",
+               100.0 * t.x(), 100.0 * t.y(), 100.0 * t.z());
+  return t;
+}
+
+// The trajectory of a camera rigidly mounted at `offset` in the colour camera's frame (both look the same way).
+Trajectory moved_to_camera(Trajectory traj, const std::optional<Eigen::Vector3d>& offset) {
+  if (offset)
+    for (StampedPose& p : traj) p.T_wc.translation() += p.T_wc.linear() * *offset;
+  return traj;
+}
+
 void write_map_ply(const slam::Map& map, const std::filesystem::path& file) {
   std::vector<Eigen::Vector3d> pts;
   for (const auto& mp : map.map_points())
@@ -317,8 +340,15 @@ RunSummary run_slam(const Dataset& dataset, const Settings& settings, const RunO
                        {"localization_only", options.localization_only}};
   std::optional<Eigen::Isometry3d> alignment;
   if (groundtruth && traj.size() >= 2) {
-    alignment = evaluate_against(*groundtruth, traj, slam.live_trajectory(), metrics.frame_timestamps(),
+    const std::optional<Eigen::Vector3d> offset = groundtruth_camera_offset(settings, slam);
+    m["ate_camera"] = offset ? "depth" : "colour";
+    alignment = evaluate_against(*groundtruth, moved_to_camera(traj, offset),
+                                 moved_to_camera(slam.live_trajectory(), offset), metrics.frame_timestamps(),
                                  slam.loaded_map_alignment(), out_dir, m, sum);
+    // What the sensor's depth allows: the same check at the ground truth's poses, moved to the colour camera.
+    const auto colour_in_gt_camera = offset ? std::optional<Eigen::Vector3d>(-*offset) : std::nullopt;
+    m["sensor"]["long_range_consistency_groundtruth"] =
+        metrics.long_range_consistency_at(moved_to_camera(*groundtruth, colour_in_gt_camera), slam.settings().camera);
   } else if (groundtruth) {
     sum.ate_note = fmt::format("not computed: {} tracked pose{} (2 needed)", traj.size(), traj.size() == 1 ? "" : "s");
   }

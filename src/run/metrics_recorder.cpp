@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "eval/association.hpp"
+
 namespace varslam::run {
 namespace {
 
@@ -32,6 +34,7 @@ void MetricsRecorder::on_depth_registration(const DepthRegistrationEvent& e) {
     return;
   }
   registration_ = {{"mode", "auto"}, {"found", e.found}, {"scale", e.scale}, {"du", e.du}, {"dv", e.dv},
+                   {"baseline_x_m", e.baseline_x},
                    {"score", e.score}, {"identity_score", e.identity_score}, {"frames", e.frames}, {"ms", e.ms}};
   if (e.colour_camera)
     registration_["colour_camera"] = {{"fx", e.colour_camera->fx}, {"fy", e.colour_camera->fy},
@@ -80,7 +83,24 @@ nlohmann::json MetricsRecorder::sensor(const Pipeline& slam) const {
   s.depth_observations = depth_residual_m_.seen();
   s.track_length = track_lengths(slam.map());
   s.consistency = depth_consistency(keyframe_depth_, slam.camera_trajectory(), slam.settings().camera);
+  s.long_range = long_range_consistency(keyframe_depth_, slam.camera_trajectory(), slam.settings().camera);
   return sensor_section(s);
+}
+
+nlohmann::json MetricsRecorder::long_range_consistency_at(const Trajectory& poses, const PinholeCamera& cam) const {
+  Trajectory at;
+  if (!poses.empty()) {
+    Trajectory sorted = poses;
+    std::sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) { return a.timestamp < b.timestamp; });
+    std::vector<double> stamps;
+    for (const StampedPose& p : sorted) stamps.push_back(p.timestamp);
+    for (const KeyframeDepth& k : keyframe_depth_) {
+      const StampedPose& p = sorted[nearest_timestamp_index(stamps, k.timestamp)];
+      if (std::abs(p.timestamp - k.timestamp) < AssociationOptions{}.max_difference)
+        at.push_back({k.timestamp, p.T_wc});
+    }
+  }
+  return long_range_section(long_range_consistency(keyframe_depth_, at, cam));
 }
 
 void MetricsRecorder::on_detection(const DetectionEvent& d) {

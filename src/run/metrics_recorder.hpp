@@ -34,6 +34,9 @@ class MetricsRecorder final : public Observer {
   /// The metrics of the run so far; `slam` gives the facts kept by the pipeline (map size, segments, kernels).
   nlohmann::json metrics(const Pipeline& slam) const;
   const std::vector<double>& frame_timestamps() const { return stamps_; }
+  /// The long-range depth consistency of the run's keyframes at another trajectory's poses (the ground truth's: a
+  /// reference for what the sensor's depth allows), each keyframe at that trajectory's pose nearest in time.
+  nlohmann::json long_range_consistency_at(const Trajectory& poses, const PinholeCamera& cam) const;
   std::size_t frames() const { return stamps_.size(); }
   std::size_t tracked() const { return tracked_; }
   /// Medians over the frames: ORB keypoints, and the share of them with a valid depth (what a failed run lacked).

@@ -60,7 +60,10 @@ constexpr Row kRows[] = {
     {"keyframe depth disagreement, p90 (abs dz / z)", "depth_consistency", "p90", 4},
     {"inlier observations", "reprojection_px", "observations", 0},
     {"map points", "track_length", "points", 0},
+    {"distant keyframes' depth disagreement, mean of pair medians", "long_range_consistency", "mean", 4},
+    {"... the same at the ground truth's poses", "long_range_consistency_groundtruth", "mean", 4},
     {"keyframe pairs compared", "depth_consistency", "pairs", 0},
+    {"distant keyframe pairs compared", "long_range_consistency", "pairs", 0},
 };
 
 }  // namespace
@@ -129,6 +132,61 @@ DepthConsistency depth_consistency(const std::vector<KeyframeDepth>& keyframes, 
   return dc;
 }
 
+namespace {
+
+// Samples of a that depth_disagreement() would try: those with depth.
+std::size_t samples_with_depth(const KeyframeDepth& a) {
+  constexpr int every = kSampleStep / KeyframeDepth::kDepthStep;
+  std::size_t n = 0;
+  for (int r = 0; r < a.depth_mm.rows; r += every)
+    for (int c = 0; c < a.depth_mm.cols; c += every) n += a.depth_mm.at<std::uint16_t>(r, c) > 0;
+  return n;
+}
+
+bool views_may_overlap(const Eigen::Isometry3d& T_wa, const Eigen::Isometry3d& T_wb, const DistantPairs& rule) {
+  const double cos_angle = T_wa.linear().col(2).dot(T_wb.linear().col(2));
+  return cos_angle >= std::cos(rule.max_angle_deg * M_PI / 180.0) &&
+         (T_wa.translation() - T_wb.translation()).norm() <= rule.max_distance_m;
+}
+
+}  // namespace
+
+LongRangeConsistency long_range_consistency(const std::vector<KeyframeDepth>& keyframes, const Trajectory& poses,
+                                            const PinholeCamera& cam, const DistantPairs& rule) {
+  std::map<double, Eigen::Isometry3d> pose_at;
+  for (const StampedPose& p : poses) pose_at.emplace(p.timestamp, p.T_wc);
+  std::vector<std::pair<std::size_t, std::size_t>> candidates;
+  for (std::size_t i = 0; i < keyframes.size(); ++i)
+    for (std::size_t j = i + 1; j < keyframes.size(); ++j) {
+      const auto pa = pose_at.find(keyframes[i].timestamp), pb = pose_at.find(keyframes[j].timestamp);
+      if (keyframes[j].timestamp - keyframes[i].timestamp < rule.min_gap_s || pa == pose_at.end() ||
+          pb == pose_at.end() || !views_may_overlap(pa->second, pb->second, rule))
+        continue;
+      candidates.emplace_back(i, j);
+    }
+  LongRangeConsistency out;
+  out.candidates = candidates.size();
+  const std::size_t n = std::min(candidates.size(), rule.max_pairs);
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto [i, j] = candidates[k * candidates.size() / n];
+    const KeyframeDepth &a = keyframes[i], &b = keyframes[j];
+    std::vector<double> d = depth_disagreement(a, pose_at.at(a.timestamp), b, pose_at.at(b.timestamp), cam);
+    std::erase_if(d, [&](double x) { return x >= rule.same_surface; });
+    const std::size_t with_depth = samples_with_depth(a);
+    if (d.empty() || static_cast<double>(d.size()) < rule.min_overlap * static_cast<double>(with_depth)) continue;
+    out.pair_median.push_back(percentile(std::move(d), 0.5));
+  }
+  return out;
+}
+
+nlohmann::json long_range_section(const LongRangeConsistency& c, const DistantPairs& rule) {
+  return {{"mean", mean(c.pair_median)},
+          {"median", percentile(c.pair_median, 0.5)},
+          {"pairs", c.pair_median.size()},
+          {"candidates", c.candidates},
+          {"min_gap_s", rule.min_gap_s}};
+}
+
 std::vector<double> track_lengths(const slam::Map& map) {
   std::vector<double> n;
   for (const auto& mp : map.map_points())
@@ -160,6 +218,7 @@ nlohmann::json sensor_section(const SensorSamples& s) {
         {"pixels", dc.disagreement.size()},
         {"pairs", dc.pairs},
         {"sample_step_px", kSampleStep}}},
+      {"long_range_consistency", long_range_section(s.long_range)},
   };
 }
 

@@ -51,6 +51,27 @@ struct DepthConsistency {
 DepthConsistency depth_consistency(const std::vector<KeyframeDepth>& keyframes, const Trajectory& final_poses,
                                    const PinholeCamera& cam);
 
+/// Drift that neighbouring keyframes cannot show: keyframe pairs at least `min_gap_s` apart whose views overlap
+/// (optical axes within `max_angle_deg`, centres within `max_distance_m`, and at least `min_overlap` of a's
+/// samples with depth on the same surface in b, |dz| / z below `same_surface`), at most `max_pairs` of them spread
+/// evenly over the candidates. Per pair, the median |dz| / z of the samples on the same surface.
+struct DistantPairs {
+  double min_gap_s = 5.0;
+  double max_angle_deg = 60.0;
+  double max_distance_m = 3.0;
+  double same_surface = 0.05;
+  double min_overlap = 0.3;
+  std::size_t max_pairs = 400;
+};
+struct LongRangeConsistency {
+  std::vector<double> pair_median;  // one per compared pair
+  std::size_t candidates = 0;       // pairs that passed the gap and pose checks, before the cap
+};
+LongRangeConsistency long_range_consistency(const std::vector<KeyframeDepth>& keyframes, const Trajectory& poses,
+                                            const PinholeCamera& cam, const DistantPairs& rule = {});
+/// The metrics.json form: mean and median of the pair medians, pairs compared, candidates, the gap.
+nlohmann::json long_range_section(const LongRangeConsistency& c, const DistantPairs& rule = {});
+
 /// Keyframes observing each map point of the map (points not bad).
 std::vector<double> track_lengths(const slam::Map& map);
 
@@ -87,6 +108,7 @@ struct SensorSamples {
   std::size_t reprojection_observations = 0, depth_observations = 0;
   std::vector<double> track_length;                              // per map point
   DepthConsistency consistency;
+  LongRangeConsistency long_range;
 };
 nlohmann::json sensor_section(const SensorSamples& s);
 

@@ -90,6 +90,7 @@ SlamConfig slam_config_from(const Settings& s) {
   t.rolling_shutter_s = setting<double>(s, "camera.rolling_shutter_ms") / 1000.0;
   t.depth_rig = read_depth_rig(s);
   t.estimate_registration = setting<std::string>(s, "depth.registration") == "auto";
+  t.registration_max_baseline_m = setting<double>(s, "depth.registration_max_baseline_m");
   t.disparity_weight = setting<double>(s, "depth.disparity_weight");
   t.vo_points = setting<int>(s, "tracking.vo_points");
   t.close_keyframe_gap = setting<int>(s, "tracking.close_keyframe_gap");

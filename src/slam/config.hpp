@@ -78,6 +78,7 @@ struct TrackingConfig {
   // Without depth_rig: check on a few frames whether depth is registered to colour, and register it when it
   // clearly is not (pipeline/slam.cpp; depth.registration: auto | off).
   bool estimate_registration = setting_keys::text_default("depth.registration") == "auto";
+  double registration_max_baseline_m = setting_keys::real_default("depth.registration_max_baseline_m");
   optim::PoseProblemObserver pose_observer;  // debug/benchmark hook: sees every pose problem (empty: none)
 };
 

@@ -91,7 +91,8 @@ void LiveViewer::log(std::string_view event, const nlohmann::json& data) {
 
 void LiveViewer::on_depth_registration(const DepthRegistrationEvent& e) {
   const CallbackTimer timer(*this);
-  log("registration", {{"mode", e.mode}, {"found", e.found}, {"scale", e.scale}, {"du", e.du}, {"dv", e.dv}});
+  log("registration", {{"mode", e.mode}, {"found", e.found}, {"scale", e.scale}, {"du", e.du}, {"dv", e.dv},
+                      {"baseline_x_m", e.baseline_x}});
 }
 
 void LiveViewer::on_detection(const DetectionEvent& e) {

@@ -73,6 +73,50 @@ TEST(ColourRegistration, RecoversAKnownZoomAndShift) {
   EXPECT_NEAR(c.bf / c.fx, d.bf / d.fx, 1e-12) << "the baseline in metres is kept";
 }
 
+// The colour image of a colour camera `tx` metres beside the depth camera (depth origin in the colour frame at
+// (tx, 0, 0)): near surfaces bright, the wall and pixels nothing lands on dark, plus noise.
+cv::Mat colour_view_with_baseline(const cv::Mat& depth, const PinholeCamera& d, const PinholeCamera& colour, double tx,
+                                  int seed) {
+  DepthCameraRig rig;
+  rig.depth = d;
+  rig.t_colour_depth = {tx, 0.0, 0.0};
+  const cv::Mat z = register_depth_to_colour(depth, rig, colour);
+  cv::Mat gray(depth.size(), CV_8UC1);
+  std::mt19937 rng(static_cast<unsigned>(seed) + 100);
+  std::normal_distribution<double> noise(0.0, 4.0);
+  for (int v = 0; v < gray.rows; ++v)
+    for (int u = 0; u < gray.cols; ++u) {
+      const float zc = z.at<float>(v, u);
+      gray.at<std::uint8_t>(v, u) = cv::saturate_cast<std::uint8_t>((zc > 0 && zc < 3.0f ? 180.0 : 70.0) + noise(rng));
+    }
+  return gray;
+}
+
+// A shift alone fits the baseline's parallax at one depth only; the boxes at 1-2 m and the wall at 4 m tell it.
+TEST(ColourRegistration, RecoversTheBaselineBetweenTheCameras) {
+  const PinholeCamera d = depth_camera();
+  PinholeCamera colour = d;
+  colour.fx = colour.fy = 0.9 * d.fx;
+  colour.cx = d.cx + 3.0;
+  colour.cy = d.cy - 1.0;
+  std::vector<cv::Mat> grays, depths;
+  for (int i = 0; i < 8; ++i) {
+    depths.push_back(depth_scene(i));
+    grays.push_back(colour_view_with_baseline(depths.back(), d, colour, -0.03, i));
+  }
+  const ColourRegistration r = estimate_colour_registration(grays, depths, d);
+  EXPECT_TRUE(r.found);
+  EXPECT_NEAR(r.baseline_x, -0.03, 0.004);
+  EXPECT_NEAR(r.scale, 0.9, 0.006);
+  EXPECT_NEAR(r.du, 3.0, 1.51);
+  EXPECT_NEAR(r.dv, -1.0, 1.01);
+  ColourRegistrationSearch shift_only;
+  shift_only.max_baseline_m = 0.0;
+  const ColourRegistration s = estimate_colour_registration(grays, depths, d, shift_only);
+  EXPECT_EQ(s.baseline_x, 0.0);
+  EXPECT_GT(r.score, 1.05 * s.score) << "the baseline fits the edges at every depth, a shift at one";
+}
+
 TEST(ColourRegistration, RegisteredImagesStayIdentity) {
   const PinholeCamera d = depth_camera();
   std::vector<cv::Mat> grays, depths;
@@ -85,6 +129,7 @@ TEST(ColourRegistration, RegisteredImagesStayIdentity) {
   EXPECT_NEAR(r.scale, 1.0, 0.003);
   EXPECT_NEAR(r.du, 0.0, 1.01);
   EXPECT_NEAR(r.dv, 0.0, 1.01);
+  EXPECT_NEAR(r.baseline_x, 0.0, 0.003);
 }
 
 TEST(ColourRegistration, NoDepthEdgesIsNotFound) {
@@ -120,7 +165,11 @@ TEST(ColourRegistration, RealKitchenIsTheKinectColourCamera) {
   EXPECT_TRUE(r.found);
   const PinholeCamera c = r.colour_camera(depth_camera());
   EXPECT_NEAR(c.fx, 530.0, 8.0);
-  EXPECT_NEAR(r.du, -7.0, 3.0);
+  // Kinect v1's colour camera sits about 2.5 cm from its depth (infrared) camera; at the kitchen's typical 2 m the
+  // baseline and the shift together move a pixel by about -7 px.
+  EXPECT_LT(r.baseline_x, -0.01);
+  EXPECT_GT(r.baseline_x, -0.045);
+  EXPECT_NEAR(r.du + c.fx * r.baseline_x / 2.0, -7.0, 3.0);
   EXPECT_NEAR(r.dv, -1.0, 3.0);
 }
 

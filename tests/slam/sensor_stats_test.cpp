@@ -74,6 +74,43 @@ TEST(SensorStats, ConsistencySkipsPairsAcrossASegmentOrWithoutAPose) {
   EXPECT_EQ(run::percentile(dc.disagreement, 1.0), 0.0);
 }
 
+Trajectory at_identity(std::initializer_list<double> stamps) {
+  Trajectory t;
+  for (double s : stamps) t.push_back({s, Eigen::Isometry3d::Identity()});
+  return t;
+}
+
+// Distant keyframes are compared only where their views overlap; a pose that drifted 4 cm towards the wall shows
+// as the disagreement 4 cm / 2 m that neighbouring keyframes, both drifted alike, would hide.
+TEST(SensorStats, LongRangeConsistencyComparesDistantOverlappingKeyframes) {
+  const PinholeCamera cam;
+  const std::vector<KeyframeDepth> kfs = {wall(0, 2.0f), wall(3, 2.0f), wall(10, 1.96f)};
+  const run::LongRangeConsistency same = run::long_range_consistency(kfs, at_identity({0, 3, 10}), cam);
+  EXPECT_EQ(same.candidates, 2u);  // 0-10 and 3-10: 0-3 are only 3 s apart
+  ASSERT_EQ(same.pair_median.size(), 2u);
+  EXPECT_NEAR(same.pair_median[0], 0.04 / 1.96, 1e-3);  // the poses say the wall stayed where it was
+
+  Trajectory drifted = at_identity({0, 3, 10});
+  drifted[2].T_wc = moved_forward(0.04);  // the pose that explains the nearer wall
+  const run::LongRangeConsistency fixed = run::long_range_consistency(kfs, drifted, cam);
+  ASSERT_EQ(fixed.pair_median.size(), 2u);
+  EXPECT_LT(fixed.pair_median[0], 1e-3);
+
+  Trajectory turned = at_identity({0, 3, 10});
+  turned[2].T_wc.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  EXPECT_EQ(run::long_range_consistency(kfs, turned, cam).candidates, 0u);  // looking another way
+
+  // Another surface (3 m where 2 m was seen): no overlap, so the pair is a candidate but not compared.
+  const run::LongRangeConsistency other =
+      run::long_range_consistency({wall(0, 2.0f), wall(10, 3.0f)}, at_identity({0, 10}), cam);
+  EXPECT_EQ(other.candidates, 1u);
+  EXPECT_TRUE(other.pair_median.empty());
+
+  run::DistantPairs one;
+  one.max_pairs = 1;
+  EXPECT_EQ(run::long_range_consistency(kfs, at_identity({0, 3, 10}), cam, one).pair_median.size(), 1u);
+}
+
 TEST(SensorStats, TheTableShowsEachRunAndADashWhereANumberIsMissing) {
   const nlohmann::json a = {{"reprojection_px", {{"median", 0.5}, {"p95", 1.25}}},
                             {"depth_residual_m", {{"median", 0.002}}}};
@@ -144,6 +181,9 @@ TEST(SensorStats, EveryRunReportsSaneSensorStatistics) {
   EXPECT_GT(dc["pixels"].get<std::size_t>(), 1000u);
   EXPECT_LT(dc["median"].get<double>(), 0.05);  // a static room at good poses agrees with itself within a few %
   EXPECT_GE(dc["p90"].get<double>(), dc["median"].get<double>());
+  // 4 s: no keyframes 5 s apart; the ground truth's reference is there (a sequence with ground truth).
+  EXPECT_EQ(s["long_range_consistency"]["candidates"].get<std::size_t>(), 0u);
+  EXPECT_EQ(s["long_range_consistency_groundtruth"]["pairs"].get<std::size_t>(), 0u);
 }
 
 TEST(SensorStats, NoisierDepthGivesLargerDepthResiduals) {
