@@ -179,6 +179,7 @@ inline constexpr KeySpec kKeys[] = {
     detail::flag("loop.global_ba", true, "global BA after each closed loop"),
     detail::integer("loop.global_ba_iterations", 10, 1, 1000, "iterations of that global BA"),
     detail::flag("loop.final_global_ba", false, "one global BA when the run ends"),
+    detail::flag("loop.final_dense_refine", false, "when the run ends, align keyframes seen 5 s or more apart whose views overlap by dense ICP on their depth, and correct the keyframes' poses with those alignments (pose graph)"),
 
     // relocalization: recovery after tracking loss.
     detail::flag("relocalization.enabled", true, "relocalize against the place database when tracking is lost"),

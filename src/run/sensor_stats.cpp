@@ -9,6 +9,7 @@
 #include <numeric>
 
 #include "core/error.hpp"
+#include "slam/dense_alignment.hpp"
 #include "slam/map.hpp"
 
 namespace varslam::run {
@@ -76,21 +77,9 @@ double percentile(std::vector<double> v, double q) {
   return v[k];
 }
 
+// Nearest pixels, never averaged: an average across a depth edge would invent a surface between the two.
 KeyframeDepth keep_keyframe_depth(double timestamp, bool new_segment, const cv::Mat& depth_m) {
-  constexpr int s = KeyframeDepth::kDepthStep;
-  KeyframeDepth k{timestamp, new_segment, cv::Mat()};
-  if (depth_m.empty() || depth_m.type() != CV_32FC1) return k;
-  // Nearest pixels, never averaged: an average across a depth edge would invent a surface between the two.
-  k.depth_mm.create((depth_m.rows + s - 1) / s, (depth_m.cols + s - 1) / s, CV_16UC1);
-  for (int r = 0; r < k.depth_mm.rows; ++r) {
-    const float* in = depth_m.ptr<float>(r * s);
-    auto* out = k.depth_mm.ptr<std::uint16_t>(r);
-    for (int c = 0; c < k.depth_mm.cols; ++c) {
-      const float d = in[c * s];
-      out[c] = std::isfinite(d) && d > 0 ? static_cast<std::uint16_t>(std::min(1000.0f * d + 0.5f, 65535.0f)) : 0;
-    }
-  }
-  return k;
+  return {timestamp, new_segment, slam::depth_mm_every(depth_m, KeyframeDepth::kDepthStep)};
 }
 
 std::vector<double> depth_disagreement(const KeyframeDepth& a, const Eigen::Isometry3d& T_wa, const KeyframeDepth& b,

@@ -127,6 +127,7 @@ SlamConfig slam_config_from(const Settings& s) {
   l.global_ba = setting<bool>(s, "loop.global_ba");
   l.global_ba_iterations = setting<int>(s, "loop.global_ba_iterations");
   l.final_global_ba = setting<bool>(s, "loop.final_global_ba");
+  l.final_dense_refine = setting<bool>(s, "loop.final_dense_refine");
 
   RelocalizationConfig& r = c.relocalization;
   r.enabled = setting<bool>(s, "relocalization.enabled");

@@ -113,6 +113,7 @@ struct LoopConfig {
   bool global_ba = setting_keys::bool_default("loop.global_ba");
   int global_ba_iterations = setting_keys::int_default("loop.global_ba_iterations");
   bool final_global_ba = setting_keys::bool_default("loop.final_global_ba");  // one global BA when the run ends
+  bool final_dense_refine = setting_keys::bool_default("loop.final_dense_refine");  // slam/dense_refinement.hpp
 };
 
 struct RelocalizationConfig {

@@ -22,8 +22,8 @@ bool descends_from(const KeyFramePtr& kf, const KeyFrame* ancestor) {
 }  // namespace
 
 KeyFrame::KeyFrame(long id, const Frame& frame)
-    : id_(id), frame_id_(frame.id), timestamp_(frame.timestamp), features_(frame.features), T_cw_(frame.T_cw),
-      map_points_(frame.map_points) {}
+    : id_(id), frame_id_(frame.id), timestamp_(frame.timestamp), features_(frame.features),
+      depth_sample_(DepthSample::of(frame.depth)), T_cw_(frame.T_cw), map_points_(frame.map_points) {}
 
 Eigen::Isometry3d KeyFrame::pose() const {
   std::lock_guard lock(pose_mutex_);

@@ -287,6 +287,26 @@ void LoopCloser::propagate(const std::map<long, Eigen::Isometry3d>& before, cons
   }
 }
 
+DenseRefinementResult LoopCloser::refine_with_depth() {
+  std::vector<KeyFramePtr> kfs;
+  for (const auto& k : map_.keyframes())
+    if (!k->is_bad()) kfs.push_back(k);
+  if (kfs.size() < 2) return {};
+  std::map<long, Eigen::Isometry3d> before;
+  std::vector<Eigen::Isometry3d> T_cw;
+  for (const auto& k : kfs) {
+    before[k->id()] = k->pose();
+    T_cw.push_back(k->pose());
+  }
+  const DenseRefinementResult r = refine_poses_with_depth(kfs, kfs.front()->features().camera, T_cw);
+  if (r.edges == 0) return r;
+  std::unique_lock lock(map_.update_mutex());
+  for (std::size_t i = 0; i < kfs.size(); ++i) kfs[i]->set_pose(T_cw[i]);
+  propagate(before, kfs.back());
+  map_.note_correction();
+  return r;
+}
+
 double LoopCloser::run_global_ba() {
   const auto kfs = map_.keyframes();
   if (kfs.empty()) return 0;

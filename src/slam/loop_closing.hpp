@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "slam/config.hpp"
+#include "slam/dense_refinement.hpp"
 #include "slam/keyframe_database.hpp"
 #include "slam/map.hpp"
 #include "slam/system_events.hpp"
@@ -33,6 +34,9 @@ class LoopCloser {
 
   /// Bundle adjustment of the whole map (Huber); returns its milliseconds.
   double run_global_ba();
+  /// Corrects every keyframe with dense alignments between distant keyframes (slam/dense_refinement.hpp); points
+  /// follow their reference keyframes. Call when no other thread changes the map.
+  DenseRefinementResult refine_with_depth();
 
  private:
   struct Detection {
