@@ -32,4 +32,10 @@ double rotation_angle(const Eigen::Matrix3d& Ra, const Eigen::Matrix3d& Rb) {
   return Eigen::AngleAxisd(Ra.transpose() * Rb).angle();
 }
 
+bool views_may_overlap(const Eigen::Isometry3d& T_wa, const Eigen::Isometry3d& T_wb, double max_angle_deg,
+                       double max_distance_m) {
+  return T_wa.linear().col(2).dot(T_wb.linear().col(2)) >= std::cos(max_angle_deg * M_PI / 180.0) &&
+         (T_wa.translation() - T_wb.translation()).norm() <= max_distance_m;
+}
+
 }  // namespace varslam

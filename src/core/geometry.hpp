@@ -20,5 +20,9 @@ Eigen::Isometry3d se3_left_update(const Eigen::Isometry3d& T, const Eigen::Matri
 Eigen::Isometry3d normalized(const Eigen::Isometry3d& T);
 /// Rotation angle in radians between two rotations.
 double rotation_angle(const Eigen::Matrix3d& Ra, const Eigen::Matrix3d& Rb);
+/// Whether two cameras (camera-to-world poses) may see the same surface: optical axes at most `max_angle_deg`
+/// apart and centres at most `max_distance_m` apart.
+bool views_may_overlap(const Eigen::Isometry3d& T_wa, const Eigen::Isometry3d& T_wb, double max_angle_deg,
+                       double max_distance_m);
 
 }  // namespace varslam

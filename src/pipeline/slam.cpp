@@ -316,6 +316,7 @@ FrameResult Pipeline::track(const RgbdFrame& input, const std::optional<Detectio
   }
 
   if (dense_ && out.new_keyframe) give_dense_keyframe(frame, out);
+  if (cfg_.loop.final_dense_refine && out.new_keyframe) keep_keyframe_depth(frame, out);
   if (detection_) {
     detection_->index = r.index;
     emit(*std::exchange(detection_, std::nullopt), &Observer::on_detection);
@@ -332,8 +333,7 @@ FrameResult Pipeline::track(const RgbdFrame& input, const std::optional<Detectio
   return r;
 }
 
-// What the keyframe shows that moved (dense/mover_mask.hpp), gathered from the person filter, the near-mover track,
-// the keypoints tracking flagged and the caller's mask; the mask itself is made on the dense map's thread.
+// The dense map gets the keyframe's images and what moved in them; the mask itself is made on the dense map's thread.
 void Pipeline::give_dense_keyframe(const RgbdFrame& frame, const slam::TrackOutcome& out) {
   dense::DenseKeyframe kf;
   kf.id = out.keyframe_id;
@@ -341,7 +341,24 @@ void Pipeline::give_dense_keyframe(const RgbdFrame& frame, const slam::TrackOutc
   kf.depth = frame.depth;
   kf.bgr = frame.bgr;
   kf.pose = [k = out.new_keyframe] { return Eigen::Isometry3d(k->resolved_pose().inverse()); };
-  dense::MoverMaskInputs& m = kf.movers;
+  kf.movers = mover_inputs(frame, out);
+  dense_->add(std::move(kf));
+}
+
+// The keyframe keeps its depth for the dense refinement when the run ends, without the movers someone named (person
+// boxes, the caller's mask). Not without the near mover tracking follows: in real scenes it also follows static
+// near surfaces for seconds (BENCHMARKS.md), and hiding those costs the alignments more than a mover in view does.
+void Pipeline::keep_keyframe_depth(const RgbdFrame& frame, const slam::TrackOutcome& out) {
+  dense::MoverMaskInputs named = mover_inputs(frame, out);
+  named.near_movers.clear();
+  named.moving_points.clear();
+  out.new_keyframe->set_depth_sample(slam::DepthSample::of(frame.depth, dense::mover_mask(frame.depth, named)));
+}
+
+// What the keyframe shows that moved (dense/mover_mask.hpp), gathered from the person filter, the near-mover track,
+// the keypoints tracking flagged and the caller's mask.
+dense::MoverMaskInputs Pipeline::mover_inputs(const RgbdFrame& frame, const slam::TrackOutcome& out) const {
+  dense::MoverMaskInputs m;
   m.point_radius_px = dense_cfg_->point_radius_px;
   m.margin_px = dense_cfg_->margin_px;
   m.caller_mask = frame.mover_mask;
@@ -367,7 +384,7 @@ void Pipeline::give_dense_keyframe(const RgbdFrame& frame, const slam::TrackOutc
       if (on_mover || outlier) m.moving_points.push_back({F.keypoints[i].pt, F.has_depth(i) ? F.depth[i] : 0.0f});
     }
   }
-  dense_->add(std::move(kf));
+  return m;
 }
 
 void Pipeline::deliver_queued() {

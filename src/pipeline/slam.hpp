@@ -38,6 +38,7 @@ class DynamicKeypointMasker;
 namespace dense {
 class DenseMapper;
 struct DenseConfig;
+struct MoverMaskInputs;
 }
 
 struct PipelineOptions {
@@ -157,6 +158,8 @@ class Pipeline {
   std::unique_ptr<dense::DenseConfig> dense_cfg_;
   std::shared_ptr<dense::DenseMapper> dense_;  // dense.enabled: built by start() (it needs the colour camera)
   void give_dense_keyframe(const RgbdFrame& frame, const slam::TrackOutcome& out);
+  void keep_keyframe_depth(const RgbdFrame& frame, const slam::TrackOutcome& out);
+  dense::MoverMaskInputs mover_inputs(const RgbdFrame& frame, const slam::TrackOutcome& out) const;
   const slam::Map empty_map_;               // what map() shows before the first frame
   Trajectory live_;
   std::optional<mapfile::SavedMap> pending_map_;  // loaded, adopted when the system starts

@@ -9,6 +9,7 @@
 #include <numeric>
 
 #include "core/error.hpp"
+#include "core/geometry.hpp"
 #include "slam/dense_alignment.hpp"
 #include "slam/map.hpp"
 
@@ -132,12 +133,6 @@ std::size_t samples_with_depth(const KeyframeDepth& a) {
   return n;
 }
 
-bool views_may_overlap(const Eigen::Isometry3d& T_wa, const Eigen::Isometry3d& T_wb, const DistantPairs& rule) {
-  const double cos_angle = T_wa.linear().col(2).dot(T_wb.linear().col(2));
-  return cos_angle >= std::cos(rule.max_angle_deg * M_PI / 180.0) &&
-         (T_wa.translation() - T_wb.translation()).norm() <= rule.max_distance_m;
-}
-
 }  // namespace
 
 LongRangeConsistency long_range_consistency(const std::vector<KeyframeDepth>& keyframes, const Trajectory& poses,
@@ -149,7 +144,7 @@ LongRangeConsistency long_range_consistency(const std::vector<KeyframeDepth>& ke
     for (std::size_t j = i + 1; j < keyframes.size(); ++j) {
       const auto pa = pose_at.find(keyframes[i].timestamp), pb = pose_at.find(keyframes[j].timestamp);
       if (keyframes[j].timestamp - keyframes[i].timestamp < rule.min_gap_s || pa == pose_at.end() ||
-          pb == pose_at.end() || !views_may_overlap(pa->second, pb->second, rule))
+          pb == pose_at.end() || !views_may_overlap(pa->second, pb->second, rule.max_angle_deg, rule.max_distance_m))
         continue;
       candidates.emplace_back(i, j);
     }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "core/geometry.hpp"
 
@@ -22,7 +23,51 @@ cv::Mat depth_mm_every(const cv::Mat& depth_m, int step) {
   return mm;
 }
 
-DepthSample DepthSample::of(const cv::Mat& depth_m) { return {depth_mm_every(depth_m, kStep)}; }
+namespace {
+
+// Mean depth of the pixels within `radius` of (x, y) that have depth, are not masked and lie within `tolerance` of
+// `reference`; 0 for none.
+double gated_mean(const cv::Mat& depth_m, const cv::Mat& mask, int x, int y, int radius, double reference,
+                  double tolerance) {
+  double sum = 0;
+  int n = 0;
+  for (int yy = std::max(0, y - radius); yy <= std::min(depth_m.rows - 1, y + radius); ++yy) {
+    const float* row = depth_m.ptr<float>(yy);
+    const std::uint8_t* masked = mask.empty() ? nullptr : mask.ptr<std::uint8_t>(yy);
+    for (int xx = std::max(0, x - radius); xx <= std::min(depth_m.cols - 1, x + radius); ++xx)
+      if (std::isfinite(row[xx]) && row[xx] > 0 && (!masked || !masked[xx]) &&
+          std::abs(row[xx] - reference) <= tolerance) {
+        sum += row[xx];
+        ++n;
+      }
+  }
+  return n > 0 ? sum / n : 0.0;
+}
+
+}  // namespace
+
+DepthSample DepthSample::of(const cv::Mat& depth_m, const cv::Mat& mover_mask) {
+  DepthSample s;
+  if (depth_m.empty() || depth_m.type() != CV_32FC1) return s;
+  const cv::Mat& mask = mover_mask;
+  if (!mask.empty() && (mask.size() != depth_m.size() || mask.type() != CV_8UC1))
+    throw std::invalid_argument("DepthSample::of: the mover mask must be CV_8UC1 of the depth's size");
+  s.depth_mm.create((depth_m.rows + kStep - 1) / kStep, (depth_m.cols + kStep - 1) / kStep, CV_16UC1);
+  for (int r = 0; r < s.depth_mm.rows; ++r)
+    for (int c = 0; c < s.depth_mm.cols; ++c) {
+      const int y = r * kStep, x = c * kStep;
+      const float centre = depth_m.at<float>(y, x);
+      auto& out = s.depth_mm.at<std::uint16_t>(r, c);
+      out = 0;
+      if (!std::isfinite(centre) || centre <= 0 || (!mask.empty() && mask.at<std::uint8_t>(y, x))) continue;
+      const double tolerance = 0.02 * centre + 0.005;
+      // The centre pixel is as noisy as any other: the second pass gates around the first pass's mean instead.
+      double z = gated_mean(depth_m, mask, x, y, kWindow, centre, tolerance);
+      z = gated_mean(depth_m, mask, x, y, kWindow, z, tolerance);
+      if (z > 0) out = static_cast<std::uint16_t>(std::min(1000.0 * z + 0.5, 65535.0));
+    }
+  return s;
+}
 
 namespace {
 
@@ -84,8 +129,10 @@ std::optional<DenseAlignment> align_surfaces(const Surface& target, const Surfac
   const PinholeCamera& cam = target.camera;
   Eigen::Isometry3d T = T_target_source_guess;
   DenseAlignment out;
+  bool final_gate = false;
   for (int it = 0; it < cfg.iterations; ++it) {
-    const double gate = it < 5 ? cfg.first_gate_m : cfg.final_gate_m;
+    final_gate = final_gate || it >= cfg.first_gate_iterations;
+    const double gate = final_gate ? cfg.final_gate_m : cfg.first_gate_m;
     Eigen::Matrix<double, 6, 6> A = Eigen::Matrix<double, 6, 6>::Zero();
     Eigen::Matrix<double, 6, 1> b = Eigen::Matrix<double, 6, 1>::Zero();
     int pairs = 0;
@@ -118,7 +165,10 @@ std::optional<DenseAlignment> align_surfaces(const Surface& target, const Surfac
     step.linear() = so3_exp(dx.head<3>());
     step.translation() = dx.tail<3>();
     T = step * T;
-    if (dx.norm() < 1e-7) break;
+    if (dx.norm() < cfg.settled_step) {
+      if (final_gate) break;
+      final_gate = true;  // settled under the wide gate: go on to the narrow one at once
+    }
   }
   out.T_target_source = T;
   return out;

@@ -17,11 +17,15 @@ namespace varslam::slam {
 cv::Mat depth_mm_every(const cv::Mat& depth_m, int step);
 
 /// A keyframe's depth every kStep-th pixel in both directions, in millimetres (CV_16UC1, 0 = none): ~38 kB a
-/// keyframe at 640 x 480. Nearest pixels, never averaged (an average across a depth edge invents a surface).
+/// keyframe at 640 x 480. Each sample is the mean of the pixels within kWindow of its pixel whose depth is within
+/// 2 % + 5 mm of that pixel's: per-pixel sensor noise drops, while an average never reaches across a depth edge
+/// (that would invent a surface). A pixel without depth stays without, and so does one the mover mask covers.
 struct DepthSample {
   static constexpr int kStep = 4;
+  static constexpr int kWindow = 2;  // a 5 x 5 neighbourhood centred on the sampled pixel
   cv::Mat depth_mm;
-  static DepthSample of(const cv::Mat& depth_m);
+  /// `mover_mask`: CV_8UC1 of the depth's size, non-zero where something moved (left out); may be empty.
+  static DepthSample of(const cv::Mat& depth_m, const cv::Mat& mover_mask = cv::Mat());
   bool empty() const { return depth_mm.empty(); }
 };
 
@@ -35,10 +39,12 @@ Surface surface_of(const DepthSample& sample, const PinholeCamera& full_camera);
 
 struct DenseAlignConfig {
   int iterations = 15;
-  double first_gate_m = 0.05;   // point-to-plane distance beyond which a pair is dropped, first iterations
-  double final_gate_m = 0.02;   // ... from iteration 5 on
-  double huber_m = 0.005;       // residuals beyond this are down-weighted (Huber)
-  int min_pairs = 300;          // fewer matched points: no alignment
+  int first_gate_iterations = 5;  // iterations with the wide gate at most
+  double first_gate_m = 0.05;     // point-to-plane distance beyond which a pair is dropped, first iterations
+  double final_gate_m = 0.02;     // ... then
+  double settled_step = 1e-5;     // an update smaller than this (radians and metres) ends a gate's iterations
+  double huber_m = 0.005;         // residuals beyond this are down-weighted (Huber)
+  int min_pairs = 300;            // fewer matched points: no alignment
 };
 
 struct DenseAlignment {

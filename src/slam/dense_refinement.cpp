@@ -14,20 +14,15 @@ struct Pair {
   std::size_t target, source;
 };
 
-bool views_may_overlap(const Eigen::Isometry3d& T_cw_a, const Eigen::Isometry3d& T_cw_b,
-                       const DenseRefinementConfig& cfg) {
-  const Eigen::Isometry3d a = T_cw_a.inverse(), b = T_cw_b.inverse();
-  return a.linear().col(2).dot(b.linear().col(2)) >= std::cos(cfg.max_angle_deg * M_PI / 180.0) &&
-         (a.translation() - b.translation()).norm() <= cfg.max_distance_m;
-}
-
 std::vector<Pair> candidate_pairs(const std::vector<KeyFramePtr>& kfs, const std::vector<Eigen::Isometry3d>& T_cw,
                                   const DenseRefinementConfig& cfg) {
+  std::vector<bool> has_depth;
+  for (const KeyFramePtr& kf : kfs) has_depth.push_back(!kf->depth_sample().empty());
   std::vector<Pair> out;
   for (std::size_t a = 0; a < kfs.size(); ++a)
     for (std::size_t b = a + 1; b < kfs.size(); ++b)
-      if (kfs[b]->timestamp() - kfs[a]->timestamp() >= cfg.min_gap_s && !kfs[a]->depth_sample().empty() &&
-          !kfs[b]->depth_sample().empty() && views_may_overlap(T_cw[a], T_cw[b], cfg))
+      if (kfs[b]->timestamp() - kfs[a]->timestamp() >= cfg.min_gap_s && has_depth[a] && has_depth[b] &&
+          views_may_overlap(T_cw[a].inverse(), T_cw[b].inverse(), cfg.max_angle_deg, cfg.max_distance_m))
         out.push_back({a, b});
   return out;
 }

@@ -73,7 +73,6 @@ struct Frame {
   // point is made from it.
   std::vector<bool> on_mover;
   std::shared_ptr<KeyFrame> reference_kf;
-  cv::Mat depth;  // the input's depth image (metres, CV_32FC1; shares its pixels): kept by keyframes, sampled
 
   Frame() = default;
   Frame(long frame_id, double t, std::shared_ptr<const FrameFeatures> f)

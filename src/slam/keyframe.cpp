@@ -23,7 +23,17 @@ bool descends_from(const KeyFramePtr& kf, const KeyFrame* ancestor) {
 
 KeyFrame::KeyFrame(long id, const Frame& frame)
     : id_(id), frame_id_(frame.id), timestamp_(frame.timestamp), features_(frame.features),
-      depth_sample_(DepthSample::of(frame.depth)), T_cw_(frame.T_cw), map_points_(frame.map_points) {}
+      T_cw_(frame.T_cw), map_points_(frame.map_points) {}
+
+DepthSample KeyFrame::depth_sample() const {
+  std::lock_guard lock(depth_mutex_);
+  return depth_sample_;
+}
+
+void KeyFrame::set_depth_sample(DepthSample sample) {
+  std::lock_guard lock(depth_mutex_);
+  depth_sample_ = std::move(sample);
+}
 
 Eigen::Isometry3d KeyFrame::pose() const {
   std::lock_guard lock(pose_mutex_);

@@ -28,8 +28,10 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   double timestamp() const { return timestamp_; }
   const FrameFeatures& features() const { return *features_; }
   const std::shared_ptr<const FrameFeatures>& features_ptr() const { return features_; }
-  /// Its depth at a quarter of the resolution, for dense alignment (empty for keyframes loaded from a map file).
-  const DepthSample& depth_sample() const { return depth_sample_; }
+  /// Its depth at a quarter of the resolution with movers left out, for dense alignment; empty unless the pipeline
+  /// keeps it (loop.final_dense_refine), and for keyframes loaded from a map file.
+  DepthSample depth_sample() const;
+  void set_depth_sample(DepthSample sample);
 
   Eigen::Isometry3d pose() const;  // T_cw
   Eigen::Isometry3d pose_inverse() const;  // T_wc
@@ -91,7 +93,9 @@ class KeyFrame : public std::enable_shared_from_this<KeyFrame> {
   const double timestamp_;
   int segment_ = 1;  // set once, before the keyframe is shared
   std::shared_ptr<const FrameFeatures> features_;
-  const DepthSample depth_sample_;
+
+  mutable std::mutex depth_mutex_;
+  DepthSample depth_sample_;
 
   mutable std::mutex pose_mutex_;
   Eigen::Isometry3d T_cw_;

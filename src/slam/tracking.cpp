@@ -112,9 +112,7 @@ Frame Tracker::build_frame(const RgbdFrame& input, FrameTimings& t) {
     shutter_source_.image_rows = input.gray.rows;
     if (state_ == TrackState::Ok && velocity_dt_ > 0) compensate_with(*features, velocity_, velocity_dt_);
   }
-  Frame frame(next_frame_id_++, input.timestamp, std::move(features));
-  frame.depth = input.depth;
-  return frame;
+  return Frame(next_frame_id_++, input.timestamp, std::move(features));
 }
 
 void Tracker::compensate_with(FrameFeatures& f, const Eigen::Isometry3d& motion, double dt) const {

@@ -55,7 +55,7 @@ Eigen::Isometry3d pose(double yaw_deg, double pitch_deg, const Eigen::Vector3d& 
   return T;
 }
 
-TEST(DenseAlignment, TheSampleKeepsEveryFourthPixelInMillimetres) {
+TEST(DenseAlignment, TheSampleHasEveryFourthPixelInMillimetres) {
   cv::Mat d(480, 640, CV_32FC1, cv::Scalar(2.0f));
   d.at<float>(4, 8) = 0.0f;
   d.at<float>(8, 4) = std::numeric_limits<float>::quiet_NaN();
@@ -65,6 +65,42 @@ TEST(DenseAlignment, TheSampleKeepsEveryFourthPixelInMillimetres) {
   EXPECT_EQ(s.depth_mm.at<std::uint16_t>(1, 2), 0);  // no depth stays no depth
   EXPECT_EQ(s.depth_mm.at<std::uint16_t>(2, 1), 0);  // nor does NaN become a number
   EXPECT_TRUE(DepthSample::of(cv::Mat()).empty());
+}
+
+// Per-pixel noise averages out over the sampled pixel's neighbourhood, but a depth edge is never averaged across: a
+// sample beside the edge keeps its own side's depth.
+TEST(DenseAlignment, TheSampleAveragesNoiseButNotAcrossADepthEdge) {
+  cv::Mat d(480, 640, CV_32FC1);
+  cv::RNG rng(3);
+  for (int r = 0; r < d.rows; ++r)
+    for (int c = 0; c < d.cols; ++c)
+      d.at<float>(r, c) = static_cast<float>((c < 322 ? 3.0 : 1.5) + rng.gaussian(0.015));
+  const DepthSample s = DepthSample::of(d);
+  double sum_sq = 0;
+  int n = 0;
+  for (int r = 1; r + 1 < s.depth_mm.rows; ++r)
+    for (int c = 1; c < 80; ++c) {
+      sum_sq += std::pow(s.depth_mm.at<std::uint16_t>(r, c) - 3000.0, 2);
+      ++n;
+    }
+  EXPECT_LT(std::sqrt(sum_sq / n), 15.0 / 3);  // 25 pixels: a fifth of the noise, up to the tolerance's clipping
+  for (int r = 1; r + 1 < s.depth_mm.rows; ++r) {
+    EXPECT_NEAR(s.depth_mm.at<std::uint16_t>(r, 80), 3000, 40);   // pixel 320: its window reaches 2 px past the edge
+    EXPECT_NEAR(s.depth_mm.at<std::uint16_t>(r, 81), 1500, 20);   // pixel 324
+  }
+}
+
+// A mover's pixels are neither sampled nor averaged into the samples beside them.
+TEST(DenseAlignment, TheSampleLeavesOutWhatTheMoverMaskCovers) {
+  cv::Mat d(480, 640, CV_32FC1, cv::Scalar(2.0f));
+  cv::Mat mask = cv::Mat::zeros(d.size(), CV_8UC1);
+  d(cv::Rect(100, 98, 50, 50)).setTo(2.03f);  // a mover just off the wall, within the averaging tolerance
+  mask(cv::Rect(100, 98, 50, 50)).setTo(255);
+  const DepthSample s = DepthSample::of(d, mask);
+  EXPECT_EQ(s.depth_mm.at<std::uint16_t>(30, 30), 0);     // pixel (120, 120): on the mover
+  EXPECT_EQ(s.depth_mm.at<std::uint16_t>(24, 30), 2000);  // pixel (120, 96): the wall beside it, its own depth
+  EXPECT_EQ(DepthSample::of(d).depth_mm.at<std::uint16_t>(24, 30), 2006);  // unmasked, the mover's row joins in
+  EXPECT_THROW(DepthSample::of(d, cv::Mat::zeros(10, 10, CV_8UC1)), std::invalid_argument);
 }
 
 TEST(DenseAlignment, RecoversTheRelativePoseFromAGuessCentimetresOff) {

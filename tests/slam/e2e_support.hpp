@@ -36,6 +36,17 @@ inline fs::path cached_sequence(const std::string& name, synth::SynthConfig cfg)
   return d;
 }
 
+/// The 4-s static scene (seed 7) of the end-to-end, sensor-statistics and evaluation tests, with the sensor's depth
+/// noise or without.
+inline fs::path static_4s_sequence(bool depth_noise = true) {
+  synth::SynthConfig cfg;
+  cfg.scenario = "static";
+  cfg.seconds = 4.0;
+  cfg.seed = 7;
+  cfg.depth_noise = depth_noise;
+  return cached_sequence(depth_noise ? "static_seq" : "static_seq_clean_depth", cfg);
+}
+
 /// The 2-s walking scene (seed 5) the pipeline and viewer tests share.
 inline fs::path pipeline_walking_sequence() {
   synth::SynthConfig cfg;

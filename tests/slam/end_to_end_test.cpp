@@ -22,6 +22,7 @@ using run::RunSummary;
 using run::run_slam;
 using e2e::cached_sequence;
 using e2e::run_on;
+using e2e::static_4s_sequence;
 
 std::string slurp(const fs::path& p) {
   std::ifstream in(p);
@@ -59,19 +60,8 @@ void expect_tracked_with_ate_below(const RunSummary& s, double bound_m) {
   EXPECT_LT(*s.ate_rmse, bound_m) << "ATE RMSE " << *s.ate_rmse << " m";
 }
 
-const fs::path& static_sequence() {
-  static const fs::path dir = [] {
-    synth::SynthConfig cfg;
-    cfg.scenario = "static";
-    cfg.seconds = 4.0;
-    cfg.seed = 7;
-    return cached_sequence("static_seq", cfg);
-  }();
-  return dir;
-}
-
 TEST(EndToEnd, StaticSyntheticSceneIsTrackedAccurately) {
-  const RunSummary s = run_on(static_sequence(), test_dir("static_run"), RunMode::Deterministic);
+  const RunSummary s = run_on(static_4s_sequence(), test_dir("static_run"), RunMode::Deterministic);
   EXPECT_EQ(s.lost, 0u);
   EXPECT_EQ(s.tracked, s.frames);
   ASSERT_TRUE(s.ate_rmse.has_value());
@@ -88,8 +78,8 @@ TEST(EndToEnd, StaticSyntheticSceneIsTrackedAccurately) {
 }
 
 TEST(EndToEnd, DeterministicModeIsByteIdentical) {
-  const RunSummary a = run_on(static_sequence(), test_dir("det_a"), RunMode::Deterministic, 60);
-  const RunSummary b = run_on(static_sequence(), test_dir("det_b"), RunMode::Deterministic, 60);
+  const RunSummary a = run_on(static_4s_sequence(), test_dir("det_a"), RunMode::Deterministic, 60);
+  const RunSummary b = run_on(static_4s_sequence(), test_dir("det_b"), RunMode::Deterministic, 60);
   const std::string ta = slurp(a.out_dir / "CameraTrajectory.txt");
   ASSERT_FALSE(ta.empty());
   EXPECT_EQ(ta, slurp(b.out_dir / "CameraTrajectory.txt"));
@@ -97,7 +87,7 @@ TEST(EndToEnd, DeterministicModeIsByteIdentical) {
 }
 
 TEST(EndToEnd, RealTimeModeTracksTheSameSequence) {
-  const RunSummary s = run_on(static_sequence(), test_dir("rt_run"), RunMode::RealTime);
+  const RunSummary s = run_on(static_4s_sequence(), test_dir("rt_run"), RunMode::RealTime);
   EXPECT_EQ(s.tracked, s.frames);
   ASSERT_TRUE(s.ate_rmse.has_value());
   EXPECT_LT(*s.ate_rmse, 0.03);
@@ -106,7 +96,7 @@ TEST(EndToEnd, RealTimeModeTracksTheSameSequence) {
 // Paced real time with --drop-late reports what a robot would see: every frame either tracked (with its latency) or
 // dropped because a newer one had arrived, the mapping queue, and which keyframes' Local BA was skipped or cut short.
 TEST(EndToEnd, PacedRealTimeAccountsForEveryFrameAndReportsLatency) {
-  const fs::path seq = static_sequence();
+  const fs::path seq = static_4s_sequence();
   run::RunOptions ro;
   ro.mode = RunMode::RealTime;
   ro.pace = true;

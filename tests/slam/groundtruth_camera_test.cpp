@@ -48,11 +48,7 @@ TEST(GroundTruthCamera, TheKitchenIsEvaluatedAtItsDepthCameraWhenAsked) {
 
 // Registered depth (the synthetic sequences, TUM, Bonn) has one camera: nothing to move, and the metrics say so.
 TEST(GroundTruthCamera, RegisteredDepthHasOneCamera) {
-  synth::SynthConfig cfg;
-  cfg.scenario = "static";
-  cfg.seconds = 4.0;
-  cfg.seed = 7;
-  const fs::path seq = e2e::cached_sequence("static_seq", cfg);
+  const fs::path seq = e2e::static_4s_sequence();
   const fs::path out = fs::temp_directory_path() / ("varslam_gt_camera_reg_" + std::to_string(::getpid()));
   const run::RunSummary s =
       e2e::run_on(seq, out, RunMode::Deterministic, 30, {"eval.groundtruth_camera=depth"});

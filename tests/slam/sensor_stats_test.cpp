@@ -125,20 +125,10 @@ TEST(SensorStats, TheTableShowsEachRunAndADashWhereANumberIsMissing) {
   for (std::string line; std::getline(lines, line);) EXPECT_EQ(std::count(line.begin(), line.end(), '|'), 4) << line;
 }
 
-// The 4-s static scene of the end-to-end tests, with its sensor's depth noise or without.
-fs::path static_scene(bool depth_noise) {
-  synth::SynthConfig cfg;
-  cfg.scenario = "static";
-  cfg.seconds = 4.0;
-  cfg.seed = 7;
-  cfg.depth_noise = depth_noise;
-  return e2e::cached_sequence(depth_noise ? "static_seq" : "static_seq_clean_depth", cfg);
-}
-
 nlohmann::json sensor_of_run(bool depth_noise, const std::string& name) {
   const fs::path out = fs::temp_directory_path() / ("varslam_sensor_stats_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(out);
-  const run::RunSummary s = e2e::run_on(static_scene(depth_noise), out, RunMode::Deterministic);
+  const run::RunSummary s = e2e::run_on(e2e::static_4s_sequence(depth_noise), out, RunMode::Deterministic);
   EXPECT_EQ(s.tracked, s.frames);
   fs::remove_all(out);
   nlohmann::json sensor = s.metrics.at("sensor");
