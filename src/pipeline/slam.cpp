@@ -349,15 +349,12 @@ void Pipeline::give_dense_keyframe(const RgbdFrame& frame, const slam::TrackOutc
 // boxes, the caller's mask). Not without the near mover tracking follows: in real scenes it also follows static
 // near surfaces for seconds (BENCHMARKS.md), and hiding those costs the alignments more than a mover in view does.
 void Pipeline::keep_keyframe_depth(const RgbdFrame& frame, const slam::TrackOutcome& out) {
-  dense::MoverMaskInputs named = mover_inputs(frame, out);
-  named.near_movers.clear();
-  named.moving_points.clear();
-  out.new_keyframe->set_depth_sample(slam::DepthSample::of(frame.depth, dense::mover_mask(frame.depth, named)));
+  out.new_keyframe->set_depth_sample(
+      slam::DepthSample::of(frame.depth, dense::mover_mask(frame.depth, named_mover_inputs(frame))));
 }
 
-// What the keyframe shows that moved (dense/mover_mask.hpp), gathered from the person filter, the near-mover track,
-// the keypoints tracking flagged and the caller's mask.
-dense::MoverMaskInputs Pipeline::mover_inputs(const RgbdFrame& frame, const slam::TrackOutcome& out) const {
+// The movers someone named (dense/mover_mask.hpp): the person filter's people and the caller's mask.
+dense::MoverMaskInputs Pipeline::named_mover_inputs(const RgbdFrame& frame) const {
   dense::MoverMaskInputs m;
   m.point_radius_px = dense_cfg_->point_radius_px;
   m.margin_px = dense_cfg_->margin_px;
@@ -370,6 +367,12 @@ dense::MoverMaskInputs Pipeline::mover_inputs(const RgbdFrame& frame, const slam
       if (d.own_part_m > 0) m.people.push_back({p.rects[i], d.own_part_m, detection_->depth_band_m});
     }
   }
+  return m;
+}
+
+// What the keyframe shows that moved: the named movers, the near mover tracking follows and the keypoints it flagged.
+dense::MoverMaskInputs Pipeline::mover_inputs(const RgbdFrame& frame, const slam::TrackOutcome& out) const {
+  dense::MoverMaskInputs m = named_mover_inputs(frame);
   if (out.mover) {
     const Eigen::AlignedBox2f& r = out.mover->region;
     if (!r.isEmpty())

@@ -159,6 +159,7 @@ class Pipeline {
   std::shared_ptr<dense::DenseMapper> dense_;  // dense.enabled: built by start() (it needs the colour camera)
   void give_dense_keyframe(const RgbdFrame& frame, const slam::TrackOutcome& out);
   void keep_keyframe_depth(const RgbdFrame& frame, const slam::TrackOutcome& out);
+  dense::MoverMaskInputs named_mover_inputs(const RgbdFrame& frame) const;
   dense::MoverMaskInputs mover_inputs(const RgbdFrame& frame, const slam::TrackOutcome& out) const;
   const slam::Map empty_map_;               // what map() shows before the first frame
   Trajectory live_;

@@ -49,8 +49,7 @@ double gated_mean(const cv::Mat& depth_m, const cv::Mat& mask, int x, int y, int
 DepthSample DepthSample::of(const cv::Mat& depth_m, const cv::Mat& mover_mask) {
   DepthSample s;
   if (depth_m.empty() || depth_m.type() != CV_32FC1) return s;
-  const cv::Mat& mask = mover_mask;
-  if (!mask.empty() && (mask.size() != depth_m.size() || mask.type() != CV_8UC1))
+  if (!mover_mask.empty() && (mover_mask.size() != depth_m.size() || mover_mask.type() != CV_8UC1))
     throw std::invalid_argument("DepthSample::of: the mover mask must be CV_8UC1 of the depth's size");
   s.depth_mm.create((depth_m.rows + kStep - 1) / kStep, (depth_m.cols + kStep - 1) / kStep, CV_16UC1);
   for (int r = 0; r < s.depth_mm.rows; ++r)
@@ -59,11 +58,12 @@ DepthSample DepthSample::of(const cv::Mat& depth_m, const cv::Mat& mover_mask) {
       const float centre = depth_m.at<float>(y, x);
       auto& out = s.depth_mm.at<std::uint16_t>(r, c);
       out = 0;
-      if (!std::isfinite(centre) || centre <= 0 || (!mask.empty() && mask.at<std::uint8_t>(y, x))) continue;
+      if (!std::isfinite(centre) || centre <= 0 || (!mover_mask.empty() && mover_mask.at<std::uint8_t>(y, x)))
+        continue;
       const double tolerance = 0.02 * centre + 0.005;
       // The centre pixel is as noisy as any other: the second pass gates around the first pass's mean instead.
-      double z = gated_mean(depth_m, mask, x, y, kWindow, centre, tolerance);
-      z = gated_mean(depth_m, mask, x, y, kWindow, z, tolerance);
+      double z = gated_mean(depth_m, mover_mask, x, y, kWindow, centre, tolerance);
+      z = gated_mean(depth_m, mover_mask, x, y, kWindow, z, tolerance);
       if (z > 0) out = static_cast<std::uint16_t>(std::min(1000.0 * z + 0.5, 65535.0));
     }
   return s;
