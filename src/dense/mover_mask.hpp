@@ -37,6 +37,11 @@ struct MoverMaskInputs {
   float point_radius_px = 12;
   cv::Mat caller_mask;  // CV_8UC1, non-zero = mover; may be empty
   int margin_px = 3;
+
+  /// Names no mover: the mask would be all zero.
+  bool names_nothing() const {
+    return people.empty() && near_movers.empty() && moving_points.empty() && caller_mask.empty();
+  }
 };
 
 /// CV_8UC1 of depth's size, 255 where a mover is. `depth`: CV_32FC1 metres (0 = none).

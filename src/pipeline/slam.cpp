@@ -349,8 +349,9 @@ void Pipeline::give_dense_keyframe(const RgbdFrame& frame, const slam::TrackOutc
 // boxes, the caller's mask). Not without the near mover tracking follows: in real scenes it also follows static
 // near surfaces for seconds (BENCHMARKS.md), and hiding those costs the alignments more than a mover in view does.
 void Pipeline::keep_keyframe_depth(const RgbdFrame& frame, const slam::TrackOutcome& out) {
-  out.new_keyframe->set_depth_sample(
-      slam::DepthSample::of(frame.depth, dense::mover_mask(frame.depth, named_mover_inputs(frame))));
+  const dense::MoverMaskInputs named = named_mover_inputs(frame);
+  const cv::Mat mask = named.names_nothing() ? cv::Mat() : dense::mover_mask(frame.depth, named);
+  out.new_keyframe->set_depth_sample(slam::DepthSample::of(frame.depth, mask));
 }
 
 // The movers someone named (dense/mover_mask.hpp): the person filter's people and the caller's mask.

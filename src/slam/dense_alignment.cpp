@@ -8,6 +8,14 @@
 
 namespace varslam::slam {
 
+namespace {
+
+bool has_depth(float d) { return std::isfinite(d) && d > 0; }
+
+std::uint16_t to_mm(double z_m) { return static_cast<std::uint16_t>(std::min(1000.0 * z_m + 0.5, 65535.0)); }
+
+}  // namespace
+
 cv::Mat depth_mm_every(const cv::Mat& depth_m, int step) {
   cv::Mat mm;
   if (depth_m.empty() || depth_m.type() != CV_32FC1 || step < 1) return mm;
@@ -17,7 +25,7 @@ cv::Mat depth_mm_every(const cv::Mat& depth_m, int step) {
     auto* out = mm.ptr<std::uint16_t>(r);
     for (int c = 0; c < mm.cols; ++c) {
       const float d = in[c * step];
-      out[c] = std::isfinite(d) && d > 0 ? static_cast<std::uint16_t>(std::min(1000.0f * d + 0.5f, 65535.0f)) : 0;
+      out[c] = has_depth(d) ? to_mm(d) : 0;
     }
   }
   return mm;
@@ -35,7 +43,7 @@ double gated_mean(const cv::Mat& depth_m, const cv::Mat& mask, int x, int y, int
     const float* row = depth_m.ptr<float>(yy);
     const std::uint8_t* masked = mask.empty() ? nullptr : mask.ptr<std::uint8_t>(yy);
     for (int xx = std::max(0, x - radius); xx <= std::min(depth_m.cols - 1, x + radius); ++xx)
-      if (std::isfinite(row[xx]) && row[xx] > 0 && (!masked || !masked[xx]) &&
+      if (has_depth(row[xx]) && (!masked || !masked[xx]) &&
           std::abs(row[xx] - reference) <= tolerance) {
         sum += row[xx];
         ++n;
@@ -58,13 +66,13 @@ DepthSample DepthSample::of(const cv::Mat& depth_m, const cv::Mat& mover_mask) {
       const float centre = depth_m.at<float>(y, x);
       auto& out = s.depth_mm.at<std::uint16_t>(r, c);
       out = 0;
-      if (!std::isfinite(centre) || centre <= 0 || (!mover_mask.empty() && mover_mask.at<std::uint8_t>(y, x)))
+      if (!has_depth(centre) || (!mover_mask.empty() && mover_mask.at<std::uint8_t>(y, x)))
         continue;
       const double tolerance = 0.02 * centre + 0.005;
       // The centre pixel is as noisy as any other: the second pass gates around the first pass's mean instead.
       double z = gated_mean(depth_m, mover_mask, x, y, kWindow, centre, tolerance);
       z = gated_mean(depth_m, mover_mask, x, y, kWindow, z, tolerance);
-      if (z > 0) out = static_cast<std::uint16_t>(std::min(1000.0 * z + 0.5, 65535.0));
+      if (z > 0) out = to_mm(z);
     }
   return s;
 }
