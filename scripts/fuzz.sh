@@ -22,7 +22,7 @@ fi
 flags="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined"
 cmake -S . -B build-fuzz -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -fno-omit-frame-pointer" -DCMAKE_CXX_FLAGS="$flags" \
-  -DVARSLAM_BUILD_FUZZ=ON -DVARSLAM_BUILD_TESTS=OFF -DVARSLAM_BUILD_BENCH=OFF >/dev/null
+  -DVARSLAM_BUILD_FUZZ=ON -DVARSLAM_BUILD_TESTS=OFF -DVARSLAM_BUILD_BENCH=OFF -DCMAKE_UNITY_BUILD=ON >/dev/null
 cmake --build build-fuzz -j"$JOBS" --target fuzzers
 
 names=("$@")

@@ -6,7 +6,6 @@
 #include <cstring>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
-#include <sstream>
 
 #include "bag/bag_dataset.hpp"
 #include "bag/bag_from_folder.hpp"
@@ -14,6 +13,7 @@
 #include "core/error.hpp"
 #include "io/ros_image_codec.hpp"
 #include "io/trajectory_io.hpp"
+#include "file_text.hpp"
 #include "slam/e2e_support.hpp"
 #ifdef VARSLAM_HAVE_ROSBAG
 #include "bagfile/bag_file.hpp"
@@ -36,12 +36,7 @@ std::string error_of(Fn fn) {
   return "(no error)";
 }
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using test::slurp;
 
 // --- codecs: plain bytes, no bag needed ---------------------------------------------------------------------------
 

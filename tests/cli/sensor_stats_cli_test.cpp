@@ -20,7 +20,7 @@ using ::testing::HasSubstr;
 using cli_test::Outcome;
 using cli_test::slurp;
 
-Outcome cli(const std::string& args) { return cli_test::cli(args, "varslam_sensor_cli"); }
+Outcome sensor_cli(const std::string& args) { return cli_test::cli(args, "varslam_sensor_cli"); }
 
 // A run folder holding `metrics` as its metrics.json (empty: no metrics.json at all).
 fs::path run_folder(const std::string& name, const std::string& metrics) {
@@ -44,7 +44,8 @@ TEST(SensorStatsCli, PutsRunsSideBySideAndWritesThemAsJson) {
   const fs::path b = run_folder("b", metrics_with_reprojection(0.875));
   const fs::path out = fs::temp_directory_path() / ("varslam_sensor_cli_" + std::to_string(::getpid()) + ".json");
   fs::remove(out);
-  const Outcome o = cli("sensor-stats " + a.string() + " " + b.string() + " --names real,synth --out " + out.string());
+  const Outcome o =
+      sensor_cli("sensor-stats " + a.string() + " " + b.string() + " --names real,synth --out " + out.string());
   ASSERT_EQ(o.exit_code, 0) << o.output;
   EXPECT_THAT(o.output, HasSubstr("| statistic | real | synth |"));
   EXPECT_THAT(o.output, HasSubstr("median (px) | 0.500 | 0.875 |"));
@@ -57,7 +58,7 @@ TEST(SensorStatsCli, PutsRunsSideBySideAndWritesThemAsJson) {
 
 TEST(SensorStatsCli, ColumnsAreNamedAfterTheFoldersByDefault) {
   const fs::path a = run_folder("named", metrics_with_reprojection(0.5));
-  const Outcome o = cli("sensor-stats " + a.string() + "/");
+  const Outcome o = sensor_cli("sensor-stats " + a.string() + "/");
   ASSERT_EQ(o.exit_code, 0) << o.output;
   EXPECT_THAT(o.output, HasSubstr("| statistic | " + a.filename().string() + " |"));
 }
@@ -65,35 +66,35 @@ TEST(SensorStatsCli, ColumnsAreNamedAfterTheFoldersByDefault) {
 TEST(SensorStatsCli, AMissingFolderIsAnErrorNamingIt) {
   const fs::path a = run_folder("exists", metrics_with_reprojection(0.5));
   const std::string missing = (fs::temp_directory_path() / "varslam_sensor_cli_no_such_run").string();
-  const Outcome o = cli("sensor-stats " + a.string() + " " + missing);
+  const Outcome o = sensor_cli("sensor-stats " + a.string() + " " + missing);
   EXPECT_EQ(o.exit_code, 2) << o.output;
   EXPECT_THAT(o.output, HasSubstr(missing + ": no such run folder"));
 }
 
 TEST(SensorStatsCli, AFolderWithoutMetricsIsAnErrorNamingTheFile) {
   const fs::path a = run_folder("empty", "");
-  const Outcome o = cli("sensor-stats " + a.string());
+  const Outcome o = sensor_cli("sensor-stats " + a.string());
   EXPECT_EQ(o.exit_code, 2) << o.output;
   EXPECT_THAT(o.output, HasSubstr((a / "metrics.json").string() + ": missing"));
 }
 
 TEST(SensorStatsCli, MetricsWithoutTheSectionAreAnErrorNamingTheFile) {
   const fs::path a = run_folder("old", R"({"frames": 10, "tracked_frames": 10})");
-  const Outcome o = cli("sensor-stats " + a.string());
+  const Outcome o = sensor_cli("sensor-stats " + a.string());
   EXPECT_EQ(o.exit_code, 2) << o.output;
   EXPECT_THAT(o.output, HasSubstr((a / "metrics.json").string() + ": no \"sensor\" section"));
 }
 
 TEST(SensorStatsCli, BrokenMetricsAreAnErrorNamingTheFile) {
   const fs::path a = run_folder("broken", R"({"frames": 1)");
-  const Outcome o = cli("sensor-stats " + a.string());
+  const Outcome o = sensor_cli("sensor-stats " + a.string());
   EXPECT_EQ(o.exit_code, 2) << o.output;
   EXPECT_THAT(o.output, HasSubstr((a / "metrics.json").string() + ": not valid JSON"));
 }
 
 TEST(SensorStatsCli, NamesMustMatchTheRuns) {
   const fs::path a = run_folder("one", metrics_with_reprojection(0.5));
-  const Outcome o = cli("sensor-stats " + a.string() + " --names x,y");
+  const Outcome o = sensor_cli("sensor-stats " + a.string() + " --names x,y");
   EXPECT_EQ(o.exit_code, 2) << o.output;
   EXPECT_THAT(o.output, HasSubstr("--names gives 2 names for 1 run folders"));
 }

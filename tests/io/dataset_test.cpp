@@ -62,7 +62,7 @@ void make_tum(const TempDir& dir, int n, std::uint16_t depth_value = 10000) {
 }
 
 template <typename Fn>
-std::string input_error(Fn&& fn) {
+std::string error_of(Fn&& fn) {
   try {
     fn();
   } catch (const InputError& e) {
@@ -138,12 +138,12 @@ TEST(FrameList, ListErrorsNameFileAndLine) {
                         Case{"inf a.png", "not a finite"}, Case{"1.0 b.png", "not after"},
                         Case{"0.5 b.png", "not after"}}) {
     const auto file = dir.write("rgb.txt", "# header\n1.0 a.png\n" + c.line + "\n");
-    EXPECT_THAT(input_error([&] { read_frame_list(file); }),
+    EXPECT_THAT(error_of([&] { read_frame_list(file); }),
                 AllOf(HasSubstr(file.string() + ":3:"), HasSubstr(c.expect)))
         << c.line;
   }
   const auto assoc = dir.write("associations.txt", "1.0 a.png 1.0 b.png\n2.0 a.png 2.0\n");
-  EXPECT_THAT(input_error([&] { read_associations(assoc); }), HasSubstr(assoc.string() + ":2:"));
+  EXPECT_THAT(error_of([&] { read_associations(assoc); }), HasSubstr(assoc.string() + ":2:"));
 }
 
 // ---- depth ----
@@ -250,27 +250,27 @@ TEST(Dataset, OpenLorisLayoutIsDetectedByItsListFiles) {
 
 TEST(Dataset, FolderAndListErrors) {
   TempDir dir;
-  EXPECT_THAT(input_error([&] { open_dataset(dir / "nope", tiny_settings()); }),
+  EXPECT_THAT(error_of([&] { open_dataset(dir / "nope", tiny_settings()); }),
               AllOf(HasSubstr("nope"), HasSubstr("does not exist")));
   const auto file = dir.write("file.txt", "x");
-  EXPECT_THAT(input_error([&] { open_dataset(file, tiny_settings()); }), HasSubstr("not a folder"));
-  EXPECT_THAT(input_error([&] { open_dataset(dir.path(), tiny_settings()); }), HasSubstr("rgb.txt"));
+  EXPECT_THAT(error_of([&] { open_dataset(file, tiny_settings()); }), HasSubstr("not a folder"));
+  EXPECT_THAT(error_of([&] { open_dataset(dir.path(), tiny_settings()); }), HasSubstr("rgb.txt"));
 
   make_tum(dir, 2);
   fs::remove(dir / "depth.txt");
-  EXPECT_THAT(input_error([&] { open_dataset(dir.path(), tiny_settings()); }),
+  EXPECT_THAT(error_of([&] { open_dataset(dir.path(), tiny_settings()); }),
               AllOf(HasSubstr("missing list file"), HasSubstr("depth.txt")));
 
   dir.write("depth.txt", "100.005 depth/a.png\n100.005 depth/b.png\n");  // duplicate timestamp
-  EXPECT_THAT(input_error([&] { open_dataset(dir.path(), tiny_settings()); }),
+  EXPECT_THAT(error_of([&] { open_dataset(dir.path(), tiny_settings()); }),
               AllOf(HasSubstr("depth.txt:2:"), HasSubstr("not after")));
 
   dir.write("depth.txt", "200 depth/a.png\n");  // nothing within 0.02 s
-  EXPECT_THAT(input_error([&] { open_dataset(dir.path(), tiny_settings()); }), HasSubstr("within"));
+  EXPECT_THAT(error_of([&] { open_dataset(dir.path(), tiny_settings()); }), HasSubstr("within"));
 
   fs::remove(dir / "color.txt");
   dir.write("aligned_depth.txt", "1.0 d.png\n");  // OpenLORIS without its colour list
-  EXPECT_THAT(input_error([&] { open_dataset(dir.path(), tiny_settings()); }),
+  EXPECT_THAT(error_of([&] { open_dataset(dir.path(), tiny_settings()); }),
               AllOf(HasSubstr("missing list file"), HasSubstr("color.txt")));
 }
 
@@ -287,15 +287,15 @@ TEST(Dataset, ImageErrorsNameTheFileAndListLine) {
   const auto ds = open_dataset(dir.path(), tiny_settings());
   ASSERT_EQ(ds->size(), 5u);
   const std::string rgb_list = (dir / "rgb.txt").string(), depth_list = (dir / "depth.txt").string();
-  EXPECT_THAT(input_error([&] { ds->load(0); }),
+  EXPECT_THAT(error_of([&] { ds->load(0); }),
               AllOf(HasSubstr(rgb_list + ":3:"), HasSubstr(ds_files[0].path), HasSubstr("does not exist")));
-  EXPECT_THAT(input_error([&] { ds->load(1); }),
+  EXPECT_THAT(error_of([&] { ds->load(1); }),
               AllOf(HasSubstr(rgb_list + ":4:"), HasSubstr(ds_files[1].path), HasSubstr("is not a PNG or JPEG image")));
-  EXPECT_THAT(input_error([&] { ds->load(2); }), AllOf(HasSubstr(ds_files[2].path), HasSubstr("64x24"),
+  EXPECT_THAT(error_of([&] { ds->load(2); }), AllOf(HasSubstr(ds_files[2].path), HasSubstr("64x24"),
                                                        HasSubstr("32x24")));
-  EXPECT_THAT(input_error([&] { ds->load(3); }),
+  EXPECT_THAT(error_of([&] { ds->load(3); }),
               AllOf(HasSubstr(depth_list + ":5:"), HasSubstr("8-bit"), HasSubstr("16-bit")));
-  EXPECT_THAT(input_error([&] { ds->load(4); }), AllOf(HasSubstr(depth_files[4].path), HasSubstr("32x26")));
+  EXPECT_THAT(error_of([&] { ds->load(4); }), AllOf(HasSubstr(depth_files[4].path), HasSubstr("32x26")));
 }
 
 TEST(Dataset, ImplausibleMedianDepthWarnsOnceWithTheNumbers) {
@@ -414,7 +414,7 @@ TEST(FramePrefetcher, ThrowsWhenTooManyFramesFail) {
   const auto ds = open_dataset(dir.path(), tiny_settings());
   FramePrefetcher pf(*ds);
   std::vector<std::size_t> got;
-  const std::string msg = input_error([&] {
+  const std::string msg = error_of([&] {
     while (auto f = pf.next()) got.push_back(f->index);
   });
   EXPECT_THAT(msg, AllOf(HasSubstr(dir.path().string()), HasSubstr("11 of 20")));

@@ -8,15 +8,13 @@
 
 #include "report/bench_results.hpp"
 #include "report/process_pool.hpp"
+#include "file_text.hpp"
 
 namespace varslam::report {
 namespace {
 namespace fs = std::filesystem;
 
-std::string slurp(const fs::path& f) {
-  std::ifstream in(f);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using test::slurp;
 
 TEST(BenchEndToEnd, TinyMatrixWritesResultsTablesReportsAndUpdatesMarkdown) {
   const fs::path cli = fs::path(VARSLAM_BINARY_DIR) / "bin" / "varslam";

@@ -21,6 +21,7 @@
 
 #include "report/bench_job.hpp"
 #include "report/process_pool.hpp"
+#include "file_text.hpp"
 
 extern char** environ;
 
@@ -33,10 +34,7 @@ using ::testing::Not;
 const fs::path kCli = fs::path(VARSLAM_BINARY_DIR) / "bin" / "varslam";
 const fs::path kPath = fs::path(VARSLAM_SHARED_DIR) / "trajectories" / "rgbd_dataset_freiburg3_sitting_static";
 
-std::string slurp(const fs::path& f) {
-  std::ifstream in(f);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using test::slurp;
 
 struct Shell {
   int exit_code = -1;

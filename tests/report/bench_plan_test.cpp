@@ -19,16 +19,14 @@
 #include "report/bench_job.hpp"
 #include "report/bench_plan_file.hpp"
 #include "report/bench_slurm.hpp"
+#include "file_text.hpp"
 
 namespace varslam::report {
 namespace {
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
-std::string slurp(const fs::path& f) {
-  std::ifstream in(f);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using test::slurp;
 
 // `synth --out DIR` writes a ground truth and scenario.json; `run --out DIR` writes metrics.json with an ATE of
 // 1 cm. FAKE_VARSLAM_FAIL=synth|run makes that command fail with exit code 3.

@@ -6,12 +6,12 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
-#include <sstream>
 #include <string>
 #include <unistd.h>
 
 #include "e2e_support.hpp"
 #include "io/trajectory_io.hpp"
+#include "file_text.hpp"
 
 namespace varslam::slam {
 namespace {
@@ -24,12 +24,7 @@ using e2e::cached_sequence;
 using e2e::run_on;
 using e2e::static_4s_sequence;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using test::slurp;
 
 fs::path test_dir(const std::string& name) {
   const fs::path d = fs::temp_directory_path() / ("varslam_e2e_" + name);

@@ -28,7 +28,7 @@ using namespace mapfile;
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
-fs::path static_sequence() {
+fs::path map_sequence() {
   synth::SynthConfig cfg;
   cfg.scenario = "static";
   cfg.seconds = 4.0;
@@ -63,7 +63,7 @@ run::RunOptions session_options(std::size_t first, std::size_t frames, const std
 run::RunSummary run_frames(std::size_t first, std::size_t count, const std::string& name,
                            const std::optional<fs::path>& load = std::nullopt, bool localization_only = false,
                            const std::optional<fs::path>& save = std::nullopt,
-                           const std::vector<std::string>& overrides = {}, fs::path data = static_sequence()) {
+                           const std::vector<std::string>& overrides = {}, fs::path data = map_sequence()) {
   run::RunOptions ro = session_options(first, count, load, localization_only);
   ro.save_map = save;
   const fs::path out = temp_path(name);
@@ -129,7 +129,7 @@ TEST(MapFile, SaveLoadSaveGivesTheSameBytes) {
   EXPECT_EQ(encode_map(saved), first);  // the codec alone
 
   // Through the live map: restored into a system and snapshotted again.
-  const Settings settings = settings_for_dataset(static_sequence(), std::nullopt);
+  const Settings settings = settings_for_dataset(map_sequence(), std::nullopt);
   const SlamConfig cfg = slam_config_from(settings);
   System system(cfg, settings.camera, settings.close_depth_m(), RunMode::Deterministic);
   system.adopt_map(saved);
@@ -200,7 +200,7 @@ TEST(MapFile, AnotherCameraOrPyramidIsRefused) {
 // caller's (with a warning); beyond 10 %, refused as another sensor.
 TEST(MapFile, TheMapsCameraIsUsedUnlessTheSettingsGiveIntrinsics) {
   const PinholeCamera map = load_map_file(saved_map()).fingerprint.camera;
-  const RgbdFrame frame = open_dataset(static_sequence(), settings_for_dataset(static_sequence(), std::nullopt))->load(0);
+  const RgbdFrame frame = open_dataset(map_sequence(), settings_for_dataset(map_sequence(), std::nullopt))->load(0);
   const auto camera_of_session = [&](const std::vector<std::string>& overrides) {
     Settings s;
     apply_setting_overrides(s, overrides);
@@ -234,7 +234,7 @@ TEST(MapFile, LocalizationOnlyTracksInTheLoadedMapWithoutExtendingIt) {
   // `varslam eval --map` gives the same figure from the files.
   const fs::path json = temp_path("eval_map.json");
   const std::string cmd = std::string(VARSLAM_BINARY_DIR) + "/bin/varslam eval --gt " +
-                          (static_sequence() / "groundtruth.txt").string() + " --est " +
+                          (map_sequence() / "groundtruth.txt").string() + " --est " +
                           (s.out_dir / "CameraTrajectory.txt").string() + " --map " + saved_map().string() +
                           " --json " + json.string() + " > /dev/null";
   ASSERT_EQ(std::system(cmd.c_str()), 0);

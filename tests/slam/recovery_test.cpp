@@ -90,7 +90,7 @@ RunSummary run_named(const fs::path& data, const std::string& name,
   return e2e::run_on(data, out, RunMode::Deterministic, SIZE_MAX, overrides);
 }
 
-fs::path static_sequence() {
+fs::path recovery_sequence() {
   synth::SynthConfig cfg;
   cfg.scenario = "static";
   cfg.seconds = 4.0;
@@ -101,7 +101,7 @@ fs::path static_sequence() {
 // A covered lens for a third of a second while the camera moves on: tracking is lost (black frames have no
 // keypoints), then recovered in the same map, not in a new segment.
 TEST(Recovery, CoveredLensIsRecoveredInTheSameMap) {
-  const fs::path seq = remix(static_sequence(), "covered", range(0, 60) + std::vector<int>(10, kBlack) + range(70, 120));
+  const fs::path seq = remix(recovery_sequence(), "covered", range(0, 60) + std::vector<int>(10, kBlack) + range(70, 120));
   const RunSummary s = run_named(seq, "covered");
   EXPECT_EQ(s.segments, 1);
   EXPECT_EQ(s.lost, 10u);

@@ -19,6 +19,7 @@
 #include "synth/renderer.hpp"
 #include "synth/sensor.hpp"
 #include "synth/synth.hpp"
+#include "file_text.hpp"
 
 namespace fs = std::filesystem;
 using namespace varslam;
@@ -55,10 +56,7 @@ std::vector<std::pair<double, std::string>> read_list(const fs::path& file) {
   return out;
 }
 
-std::string slurp(const fs::path& f) {
-  std::ifstream in(f, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), {}};
-}
+using test::slurp;
 
 }  // namespace
 

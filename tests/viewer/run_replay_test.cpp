@@ -12,16 +12,16 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
-fs::path walking_sequence() { return slam::e2e::pipeline_walking_sequence(); }
+fs::path replay_sequence() { return slam::e2e::pipeline_walking_sequence(); }
 
 TEST(RunReplay, AFinishedRunShowsItsFramesMapAlphasAndSavedGraph) {
   run::RunOptions ro;
   ro.progress = false;
   const fs::path out = fs::temp_directory_path() / ("varslam_replay_" + std::to_string(::getpid()));
   ro.save_map = out / "walk.map";
-  const run::RunSummary s = slam::e2e::run_with(walking_sequence(), out, ro, {"semantic.detector=boxes"});
-  const Settings settings = settings_for_dataset(walking_sequence(), std::nullopt);
-  const auto dataset = open_dataset(walking_sequence(), settings);
+  const run::RunSummary s = slam::e2e::run_with(replay_sequence(), out, ro, {"semantic.detector=boxes"});
+  const Settings settings = settings_for_dataset(replay_sequence(), std::nullopt);
+  const auto dataset = open_dataset(replay_sequence(), settings);
 
   const FinishedRun plain = load_finished_run(out, dataset.get(), std::nullopt);
   EXPECT_EQ(plain.frames, s.frames);  // every frame of the run on the slider
