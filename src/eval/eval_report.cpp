@@ -1,5 +1,7 @@
 #include "eval/eval_report.hpp"
 
+#include <fmt/format.h>
+
 #include <array>
 #include <cstdio>
 
@@ -14,10 +16,8 @@ nlohmann::json stats_json(const ErrorStatistics& s) {
 }
 
 std::string row(const char* name, const ErrorStatistics& s, const char* unit) {
-  char buf[200];
-  std::snprintf(buf, sizeof buf, "  %-18s %10.6f %10.6f %10.6f %10.6f %10.6f %10.6f  %s\n", name, s.rmse, s.mean,
-                s.median, s.std, s.min, s.max, unit);
-  return buf;
+  return fmt::format("  {:<18} {:10.6f} {:10.6f} {:10.6f} {:10.6f} {:10.6f} {:10.6f}  {}\n", name, s.rmse, s.mean,
+                     s.median, s.std, s.min, s.max, unit);
 }
 
 const std::array<const char*, 3> kAxisNames{"x", "y", "z"};
