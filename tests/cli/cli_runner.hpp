@@ -5,20 +5,15 @@
 
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
+
+#include "file_text.hpp"
 
 namespace varslam::cli_test {
 
 inline const std::string kCli = std::string(VARSLAM_BINARY_DIR) + "/bin/varslam";
 
-inline std::string slurp(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using test::slurp;
 
 struct Outcome {
   int exit_code = -1;

@@ -5,8 +5,6 @@
 
 #include <opencv2/imgcodecs.hpp>
 
-#include <fstream>
-#include <sstream>
 #include <thread>
 
 #include "core/error.hpp"
@@ -15,6 +13,7 @@
 #include "io/settings_registry.hpp"
 #include "io/trajectory_io.hpp"
 #include "slam/e2e_support.hpp"
+#include "file_text.hpp"
 
 namespace varslam {
 namespace {
@@ -30,12 +29,7 @@ fs::path out_dir(const std::string& name) {
   return d;
 }
 
-std::string file_text(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using test::slurp;
 
 // Counts what arrives, in the caller's thread.
 struct Tally final : Observer {
@@ -108,8 +102,8 @@ TEST(Pipeline, FedImagesGiveTheDatasetRunsTrajectoryAndEveryEvent) {
   EXPECT_EQ(tracked, ref.tracked);
   write_tum_trajectory(slam.camera_trajectory(), out / "api.txt");
   write_tum_trajectory(slam.live_trajectory(), out / "api_live.txt");
-  EXPECT_EQ(file_text(out / "api.txt"), file_text(out / "CameraTrajectory.txt"));
-  EXPECT_EQ(file_text(out / "api_live.txt"), file_text(out / "LiveTrajectory.txt"));
+  EXPECT_EQ(slurp(out / "api.txt"), slurp(out / "CameraTrajectory.txt"));
+  EXPECT_EQ(slurp(out / "api_live.txt"), slurp(out / "LiveTrajectory.txt"));
 
   EXPECT_EQ(tally.registrations, 1);
   EXPECT_EQ(tally.frames, 40);
@@ -146,7 +140,7 @@ TEST(Pipeline, CallersBoxesSwitchThePersonFilterOn) {
   const fs::path out = out_dir("boxes");
   write_tum_trajectory(slam.camera_trajectory(), out / "given.txt");
   write_tum_trajectory(from_file.camera_trajectory(), out / "file.txt");
-  EXPECT_EQ(file_text(out / "given.txt"), file_text(out / "file.txt"));
+  EXPECT_EQ(slurp(out / "given.txt"), slurp(out / "file.txt"));
 }
 
 TEST(Pipeline, ImagesOfTheWrongSizeOrTypeAreInputErrors) {

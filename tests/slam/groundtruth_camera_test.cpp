@@ -4,21 +4,18 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
 
 #include "e2e_support.hpp"
 #include "eval/ate.hpp"
 #include "io/trajectory_io.hpp"
+#include "file_text.hpp"
 
 namespace varslam::slam {
 namespace {
 
 namespace fs = std::filesystem;
 
-std::string file_text(const fs::path& p) {
-  std::ifstream in(p);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using test::slurp;
 
 TEST(GroundTruthCamera, TheKitchenIsEvaluatedAtItsDepthCameraWhenAsked) {
   const fs::path kitchen = fs::path(VARSLAM_SHARED_DIR) / "realdata" / "7scenes_redkitchen";
@@ -35,9 +32,9 @@ TEST(GroundTruthCamera, TheKitchenIsEvaluatedAtItsDepthCameraWhenAsked) {
   EXPECT_LT(baseline, -0.01);  // Kinect v1: the infrared camera sits beside the colour camera
   // The same estimate, evaluated at another camera: the depth camera's positions are the colour camera's moved by
   // the baseline along its own x axis.
-  const std::string estimate = file_text(out / "colour" / "CameraTrajectory.txt");
+  const std::string estimate = slurp(out / "colour" / "CameraTrajectory.txt");
   ASSERT_FALSE(estimate.empty());
-  EXPECT_EQ(file_text(out / "depth" / "CameraTrajectory.txt"), estimate);
+  EXPECT_EQ(slurp(out / "depth" / "CameraTrajectory.txt"), estimate);
   Trajectory moved = read_tum_trajectory(out / "colour" / "CameraTrajectory.txt");
   for (StampedPose& p : moved) p.T_wc.translation() += p.T_wc.linear() * Eigen::Vector3d(baseline, 0, 0);
   const AteResult expected = evaluate_ate(read_tum_trajectory(kitchen / "groundtruth.txt"), moved);

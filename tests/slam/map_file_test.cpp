@@ -19,6 +19,7 @@
 #include "pipeline/slam.hpp"
 #include "slam/e2e_support.hpp"
 #include "slam/system.hpp"
+#include "file_text.hpp"
 
 namespace varslam::slam {
 namespace {
@@ -40,12 +41,7 @@ fs::path temp_path(const std::string& name) {
   return fs::temp_directory_path() / ("varslam_map_" + name + "_" + std::to_string(::getpid()));
 }
 
-std::string bytes_of(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using test::slurp;
 
 // A run of `frames` frames from `first`, on the map `load` when given; no tracked share asked, no progress.
 run::RunOptions session_options(std::size_t first, std::size_t frames, const std::optional<fs::path>& load,
@@ -124,7 +120,7 @@ TEST(MapFile, SavedMapHasTheRunsKeyframesPointsAndGraph) {
 }
 
 TEST(MapFile, SaveLoadSaveGivesTheSameBytes) {
-  const std::string first = bytes_of(saved_map());
+  const std::string first = slurp(saved_map());
   const SavedMap saved = decode_map(first, saved_map().string());
   EXPECT_EQ(encode_map(saved), first);  // the codec alone
 
@@ -139,7 +135,7 @@ TEST(MapFile, SaveLoadSaveGivesTheSameBytes) {
 }
 
 TEST(MapFile, BrokenOrForeignFilesAreRefusedByName) {
-  const std::string good = bytes_of(saved_map());
+  const std::string good = slurp(saved_map());
   EXPECT_THAT(decode_error(""), HasSubstr("not a varslam map"));
   EXPECT_THAT(decode_error("camera:\n  fx: 500\n"), HasSubstr("not a varslam map"));
   EXPECT_THAT(decode_error(good.substr(0, good.size() / 2)), HasSubstr("truncated or corrupted"));
@@ -238,7 +234,7 @@ TEST(MapFile, LocalizationOnlyTracksInTheLoadedMapWithoutExtendingIt) {
                           (s.out_dir / "CameraTrajectory.txt").string() + " --map " + saved_map().string() +
                           " --json " + json.string() + " > /dev/null";
   ASSERT_EQ(std::system(cmd.c_str()), 0);
-  const auto j = nlohmann::json::parse(bytes_of(json));
+  const auto j = nlohmann::json::parse(slurp(json));
   EXPECT_NEAR(j["ate"]["rmse"].get<double>(), *s.ate_map_frame_rmse, 1e-9);
 }
 

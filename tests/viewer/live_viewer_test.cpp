@@ -4,14 +4,13 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
-#include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <thread>
 
 #include "core/error.hpp"
 #include "slam/e2e_support.hpp"
+#include "file_text.hpp"
 // Last: glibc's resolv.h, which it includes, defines a macro `_res` that breaks Eigen's headers after it.
 #include <fmt/format.h>
 #include <httplib.h>
@@ -25,12 +24,7 @@ using ::testing::HasSubstr;
 
 fs::path walking_sequence() { return slam::e2e::pipeline_walking_sequence(); }
 
-std::string file_text(const fs::path& f) {
-  std::ifstream in(f, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using test::slurp;
 
 run::RunSummary run_walking(const std::string& name, std::vector<Observer*> observers, bool dense = false) {
   run::RunOptions ro;
@@ -104,8 +98,8 @@ TEST(LiveViewer, TheTrajectoryIsByteIdenticalWithAndWithoutTheViewerAndABrowserC
   EventReader browser(viewer.port());
   ASSERT_TRUE(browser.wait_for("event: hello", 5s));
   const run::RunSummary watched = run_walking("watched", {&viewer});
-  EXPECT_EQ(file_text(plain.out_dir / "CameraTrajectory.txt"), file_text(watched.out_dir / "CameraTrajectory.txt"));
-  EXPECT_EQ(file_text(plain.out_dir / "LiveTrajectory.txt"), file_text(watched.out_dir / "LiveTrajectory.txt"));
+  EXPECT_EQ(slurp(plain.out_dir / "CameraTrajectory.txt"), slurp(watched.out_dir / "CameraTrajectory.txt"));
+  EXPECT_EQ(slurp(plain.out_dir / "LiveTrajectory.txt"), slurp(watched.out_dir / "LiveTrajectory.txt"));
   ASSERT_TRUE(browser.wait_for("event: done", 10s));
   const std::string got = browser.text();
   EXPECT_THAT(got, HasSubstr("event: frame"));
@@ -131,7 +125,7 @@ TEST(LiveViewer, TheDenseLayerSendsWellFormedRegionsAndLeavesTheRunsFilesAsTheyW
   ASSERT_TRUE(browser.wait_for("event: hello", 5s));
   const run::RunSummary watched = run_walking("dense_watched", {&viewer}, true);
   for (const char* f : {"CameraTrajectory.txt", "dense_mesh.ply", "dense_map.bt"})
-    EXPECT_EQ(file_text(plain.out_dir / f), file_text(watched.out_dir / f)) << f;
+    EXPECT_EQ(slurp(plain.out_dir / f), slurp(watched.out_dir / f)) << f;
   ASSERT_TRUE(browser.wait_for("event: done", 10s));
   std::this_thread::sleep_for(300ms);  // the last regions through the stream
   browser.finish();
