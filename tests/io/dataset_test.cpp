@@ -291,8 +291,8 @@ TEST(Dataset, ImageErrorsNameTheFileAndListLine) {
               AllOf(HasSubstr(rgb_list + ":3:"), HasSubstr(ds_files[0].path), HasSubstr("does not exist")));
   EXPECT_THAT(error_of([&] { ds->load(1); }),
               AllOf(HasSubstr(rgb_list + ":4:"), HasSubstr(ds_files[1].path), HasSubstr("is not a PNG or JPEG image")));
-  EXPECT_THAT(error_of([&] { ds->load(2); }), AllOf(HasSubstr(ds_files[2].path), HasSubstr("64x24"),
-                                                       HasSubstr("32x24")));
+  EXPECT_THAT(error_of([&] { ds->load(2); }),
+              AllOf(HasSubstr(ds_files[2].path), HasSubstr("64x24"), HasSubstr("32x24")));
   EXPECT_THAT(error_of([&] { ds->load(3); }),
               AllOf(HasSubstr(depth_list + ":5:"), HasSubstr("8-bit"), HasSubstr("16-bit")));
   EXPECT_THAT(error_of([&] { ds->load(4); }), AllOf(HasSubstr(depth_files[4].path), HasSubstr("32x26")));
